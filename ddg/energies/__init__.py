@@ -1,0 +1,1 @@
+"""One module per discrete energy: energy, gradient and Hessian together, vectorised."""

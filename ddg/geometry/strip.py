@@ -1,0 +1,231 @@
+"""Strip geometry, material and loading protocol as small validated value objects.
+
+SI units throughout. The scene is that of the paper (section 2, Fig. 2): a strip of
+length L, width W and thickness b, clamped at both ends; the clamp at s = L is first
+moved toward the other by dL along x (compression), then translated by dW along y
+(in-plane shear), up to the shear limit dW_max of Eq. (B.1).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+#: Paper defaults (section 2): clamps 75 mm apart after compression, shim stock b = 0.127 mm.
+CLAMP_SPAN_AFTER_COMPRESSION = 75e-3
+PAPER_THICKNESS = 0.127e-3
+PAPER_YOUNG_MODULUS = 100e9
+
+
+class InputError(ValueError):
+    """A scene or solver input outside its allowed range (one-line message)."""
+
+
+def _require(condition: bool, message: str) -> None:
+    if not condition:
+        raise InputError(message)
+
+
+def _finite_positive(name: str, value: float) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {value!r} is not a number; it must be a positive number") from None
+    _require(math.isfinite(value) and value > 0.0, f"{name} = {value!r} must be a positive finite number")
+    return value
+
+
+def shear_limit(length: float, width: float, compression: float) -> float:
+    """Largest lateral clamp translation dW_max, Eq. (B.1).
+
+    dW_max = sqrt(L^2 + W^2 - (L - dL)^2) - W: beyond it the two conical singularities at the
+    clamps would have to share a generator longer than the plate diagonal.
+    """
+    return math.sqrt(length**2 + width**2 - (length - compression) ** 2) - width
+
+
+@dataclass(frozen=True)
+class Strip:
+    """Geometry and material of the strip, with the derived stiffnesses of Eqs. (6), (A.1), (11).
+
+    length L, width W, thickness b in metres; young_modulus E in pascals; poisson_ratio nu.
+    """
+
+    length: float
+    width: float
+    thickness: float
+    young_modulus: float = PAPER_YOUNG_MODULUS
+    poisson_ratio: float = 0.0
+    density: float = 1390.0  # polyester shim stock, kg/m^3; used only by the dynamic (Eq. 7) option
+
+    def __post_init__(self) -> None:
+        for name in ("length", "width", "thickness", "young_modulus", "density"):
+            object.__setattr__(self, name, _finite_positive(name, getattr(self, name)))
+        nu = self.poisson_ratio
+        try:
+            nu = float(nu)
+        except (TypeError, ValueError):
+            raise InputError(f"poisson_ratio = {nu!r} is not a number; allowed range [0, 0.5)") from None
+        _require(math.isfinite(nu) and 0.0 <= nu < 0.5, f"poisson_ratio = {nu!r} outside the allowed range [0, 0.5)")
+        object.__setattr__(self, "poisson_ratio", nu)
+        _require(
+            self.width <= self.length,
+            f"width W = {self.width:g} m exceeds length L = {self.length:g} m; allowed 0 < W <= L",
+        )
+        _require(
+            self.thickness < self.width,
+            f"thickness b = {self.thickness:g} m must be smaller than width W = {self.width:g} m (0 < b < W)",
+        )
+
+    @classmethod
+    def from_ratios(
+        cls,
+        width_ratio: float,
+        compression_ratio: float,
+        slenderness: float | None = None,
+        **material,
+    ) -> "Strip":
+        """The paper's scene from W/L, dL/L and L/b: clamps end 75 mm apart (section 2).
+
+        L = 75 mm / (1 - dL/L); b = L / slenderness, default b = 0.127 mm.
+        """
+        compression_ratio = _ratio("compression_ratio dL/L", compression_ratio, 0.0, 1.0)
+        width_ratio = _ratio("width_ratio W/L", width_ratio, 0.0, 1.0, upper_inclusive=True)
+        length = CLAMP_SPAN_AFTER_COMPRESSION / (1.0 - compression_ratio)
+        thickness = PAPER_THICKNESS if slenderness is None else length / _finite_positive("slenderness L/b", slenderness)
+        return cls(length=length, width=width_ratio * length, thickness=thickness, **material)
+
+    # --- derived quantities -------------------------------------------------------------
+    @property
+    def shear_modulus(self) -> float:
+        return self.young_modulus / (2.0 * (1.0 + self.poisson_ratio))
+
+    @property
+    def stretching_stiffness(self) -> float:
+        """EA = E W b (N)."""
+        return self.young_modulus * self.width * self.thickness
+
+    @property
+    def geodesic_bending_stiffness(self) -> float:
+        """EI1 = E b W^3 / 12: bending in the plane of the strip (N m^2)."""
+        return self.young_modulus * self.thickness * self.width**3 / 12.0
+
+    @property
+    def bending_stiffness(self) -> float:
+        """EI2 = E W b^3 / 12: out-of-plane bending (N m^2)."""
+        return self.young_modulus * self.width * self.thickness**3 / 12.0
+
+    @property
+    def twisting_stiffness(self) -> float:
+        """GJ = E / (2 (1 + nu)) W b^3 / 3 (N m^2), Eq. (A.1)."""
+        return self.shear_modulus * self.width * self.thickness**3 / 3.0
+
+    @property
+    def plate_bending_stiffness(self) -> float:
+        """D = E b^3 / 12 (N m), per unit width (Eq. 11b prefactor)."""
+        return self.young_modulus * self.thickness**3 / 12.0
+
+    @property
+    def slenderness(self) -> float:
+        return self.length / self.thickness
+
+    @property
+    def width_ratio(self) -> float:
+        return self.width / self.length
+
+    @property
+    def euler_load(self) -> float:
+        """Clamped-clamped Euler buckling load 4 pi^2 EI2 / L^2 (N)."""
+        return 4.0 * math.pi**2 * self.bending_stiffness / self.length**2
+
+    @property
+    def force_unit(self) -> float:
+        """E b^3 / L: forces are reported as F L / (E b^3) (App. E)."""
+        return self.young_modulus * self.thickness**3 / self.length
+
+    def shear_limit(self, compression: float) -> float:
+        return shear_limit(self.length, self.width, compression)
+
+    def as_dict(self) -> dict:
+        return {
+            "length": self.length,
+            "width": self.width,
+            "thickness": self.thickness,
+            "young_modulus": self.young_modulus,
+            "poisson_ratio": self.poisson_ratio,
+            "density": self.density,
+            "width_ratio": self.width_ratio,
+            "slenderness": self.slenderness,
+        }
+
+
+def _ratio(name: str, value, low: float, high: float, upper_inclusive: bool = False) -> float:
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} = {value!r} is not a number") from None
+    upper_ok = value <= high if upper_inclusive else value < high
+    bracket = "]" if upper_inclusive else ")"
+    _require(
+        math.isfinite(value) and value > low and upper_ok,
+        f"{name} = {value!r} outside the allowed range ({low:g}, {high:g}{bracket}",
+    )
+    return value
+
+
+@dataclass(frozen=True)
+class LoadingProtocol:
+    """Quasi-static loading: compress by dL along x, then shear by dW along y (section 2).
+
+    compression_ratio dL/L in (0, 1); shear_ratio is the largest dW/L, in [0, dW_max/L]
+    (None: dW_max/L of Eq. B.1); shear_sign +1 or -1 for the direction of the lateral
+    translation; compression_steps / shear_steps are the number of recorded equilibria of
+    each stage (the solver subdivides them adaptively where needed).
+    """
+
+    compression_ratio: float
+    shear_ratio: float | None = None
+    compression_steps: int = 40
+    shear_steps: int = 120
+    shear_sign: int = 1
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "compression_ratio", _ratio("compression_ratio dL/L", self.compression_ratio, 0.0, 1.0))
+        for name, low in (("compression_steps", 1), ("shear_steps", 1)):
+            value = getattr(self, name)
+            _require(
+                isinstance(value, int) and not isinstance(value, bool) and value >= low,
+                f"{name} = {value!r} must be an integer >= {low}",
+            )
+        _require(self.shear_sign in (1, -1), f"shear_sign = {self.shear_sign!r} must be +1 or -1")
+        if self.shear_ratio is not None:
+            try:
+                value = float(self.shear_ratio)
+            except (TypeError, ValueError):
+                raise InputError(f"shear_ratio = {self.shear_ratio!r} is not a number") from None
+            _require(math.isfinite(value) and value >= 0.0, f"shear_ratio dW/L = {value!r} must be >= 0")
+            object.__setattr__(self, "shear_ratio", value)
+
+    def resolved_shear_ratio(self, strip: Strip) -> float:
+        """Largest dW/L of the run, checked against the shear limit of Eq. (B.1)."""
+        limit = strip.shear_limit(self.compression_ratio * strip.length) / strip.length
+        if self.shear_ratio is None:
+            return limit
+        _require(
+            self.shear_ratio <= limit * (1.0 + 1e-12),
+            f"shear_ratio dW/L = {self.shear_ratio:g} beyond the shear limit dW_max/L = {limit:.6g} "
+            f"(Eq. B.1) for W/L = {strip.width_ratio:g}, dL/L = {self.compression_ratio:g}; allowed [0, {limit:.6g}]",
+        )
+        return self.shear_ratio
+
+    def with_(self, **changes) -> "LoadingProtocol":
+        return replace(self, **changes)
+
+    def as_dict(self, strip: Strip | None = None) -> dict:
+        out = {
+            "compression_ratio": self.compression_ratio,
+            "shear_ratio": self.shear_ratio if strip is None else self.resolved_shear_ratio(strip),
+            "compression_steps": self.compression_steps,
+            "shear_steps": self.shear_steps,
+            "shear_sign": self.shear_sign,
+        }
+        return out

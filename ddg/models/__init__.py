@@ -1,0 +1,3 @@
+from .rod import RodModel
+
+__all__ = ["RodModel"]

@@ -1,0 +1,203 @@
+"""Discrete Anisotropic Rod (DAR), paper section 3.1.
+
+DOF vector q = [x_0, theta^0, x_1, theta^1, ..., theta^{M-2}, x_{M-1}] (Eq. 1), 4M - 1
+entries. Energy: stretching (Eq. 6a), bending with both material curvatures (Eqs. 3-4, 6b)
+and twisting with reference twist (Eqs. 5, 6c). Clamps (section 4): x_0, theta^0, x_1 and
+x_{M-2}, theta^{M-2}, x_{M-1} are prescribed, 14 DOFs; the clamped edges straddle the clamp
+points (see ddg.geometry.centerline) so the free length is exactly L. The material frame
+starts with m1 = +z (the strip normal), t = +x, m2 = t x m1 = -y.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from ..energies.rod_bending import bending_energy
+from ..energies.rod_curvature import StencilGeometry
+from ..energies.rod_twist import twist_derivatives, twisting_energy
+from ..energies.stretch import stretching_energy, two_node_blocks
+from ..geometry.centerline import Centerline
+from ..geometry.frames import material_frame, parallel_transport, reference_twist
+from ..geometry.strip import Strip
+from ..solve.banded import BandAssembler, SymmetricBanded
+
+CLAMPED_DOFS_PER_END = 7
+
+
+@dataclass
+class Evaluation:
+    energy: float
+    gradient: np.ndarray | None = None
+    hessian: SymmetricBanded | None = None
+    parts: dict | None = None
+
+
+class RodModel:
+    """The DAR of a Strip on a Centerline of M nodes, with its reference-frame state."""
+
+    name = "rod"
+    bandwidth = 10
+
+    def __init__(self, strip: Strip, nodes: int = 100):
+        self.strip = strip
+        self.centerline = Centerline(strip.length, nodes)
+        m = nodes
+        self.nodes = m
+        self.n_dof = 4 * m - 1
+        self.node_dofs = 4 * np.arange(m)[:, None] + np.arange(3)[None, :]
+        self.theta_dofs = 4 * np.arange(m - 1) + 3
+        h = self.centerline.spacing
+        self.rest_edge_lengths = np.full(m - 1, h)
+        self.voronoi_lengths = 0.5 * (self.rest_edge_lengths[:-1] + self.rest_edge_lengths[1:])
+        self.stretch_stiffness = strip.stretching_stiffness / self.rest_edge_lengths  # Eq. (6a)
+        self.constrained = np.r_[np.arange(CLAMPED_DOFS_PER_END), np.arange(self.n_dof - CLAMPED_DOFS_PER_END, self.n_dof)]
+        self.free = slice(CLAMPED_DOFS_PER_END, self.n_dof - CLAMPED_DOFS_PER_END)
+        self._assembler = BandAssembler(self.n_dof, self.bandwidth)
+        self._stretch_family = self._assembler.add_family(4 * np.arange(m - 1), 7)
+        self._stencil_family = self._assembler.add_family(4 * np.arange(m - 2), 11)
+        self._stencil_index = 4 * np.arange(m - 2)[:, None] + np.arange(11)[None, :]
+        self._edge_index = 4 * np.arange(m - 1)[:, None] + np.r_[0, 1, 2, 4, 5, 6][None, :]
+        self.reset()
+
+    # ------------------------------------------------------------------ state
+    def rest_state(self) -> np.ndarray:
+        q = np.zeros(self.n_dof)
+        q[self.node_dofs] = self.centerline.rest_positions()
+        return q
+
+    def reset(self) -> np.ndarray:
+        """Back to the flat, straight rest configuration; returns its DOF vector."""
+        m = self.nodes
+        self._tangents = np.tile([1.0, 0.0, 0.0], (m - 1, 1))
+        self._d1 = np.tile([0.0, 0.0, 1.0], (m - 1, 1))
+        self._ref_twist = np.zeros(m - 2)
+        return self.rest_state()
+
+    def positions(self, q: np.ndarray) -> np.ndarray:
+        return q[self.node_dofs]
+
+    def frames(self, q: np.ndarray):
+        """Tangents, reference d1 (transported in time from the committed state), m1, m2, m_ref."""
+        x = q[self.node_dofs]
+        edges = x[1:] - x[:-1]
+        t = edges / np.linalg.norm(edges, axis=1)[:, None]
+        d1 = parallel_transport(self._d1, self._tangents, t)
+        m1, m2 = material_frame(d1, t, q[self.theta_dofs])
+        m_ref = reference_twist(d1, t, self._ref_twist)
+        return t, d1, m1, m2, m_ref
+
+    def commit(self, q: np.ndarray) -> None:
+        """Adopt q's frames as the reference from which the next trial states are transported."""
+        t, d1, _, _, m_ref = self.frames(q)
+        self._tangents, self._d1, self._ref_twist = t, d1, m_ref
+
+    def save_frames(self):
+        return (self._tangents.copy(), self._d1.copy(), self._ref_twist.copy())
+
+    def restore_frames(self, saved) -> None:
+        self._tangents, self._d1, self._ref_twist = (a.copy() for a in saved)
+
+    # ------------------------------------------------------------------ clamps
+    def clamp_values(self, compression: float, shear: float) -> np.ndarray:
+        """Prescribed values of the 14 clamped DOFs for clamp displacement (-dL, dW, 0)."""
+        rest = self.rest_state()
+        values = rest[self.constrained].copy()
+        right = slice(CLAMPED_DOFS_PER_END, 2 * CLAMPED_DOFS_PER_END)
+        shift = np.array([-compression, shear, 0.0, 0.0, -compression, shear, 0.0])
+        values[right] += shift
+        return values
+
+    def apply_clamps(self, q: np.ndarray, compression: float, shear: float) -> np.ndarray:
+        q = q.copy()
+        q[self.constrained] = self.clamp_values(compression, shear)
+        return q
+
+    def clamp_force(self, gradient: np.ndarray) -> np.ndarray:
+        """Force (N) the moving clamp at s = L applies to the strip: dE/d(clamp translation)."""
+        g = gradient[self.node_dofs]
+        return g[-2] + g[-1]
+
+    # ------------------------------------------------------------------ energy
+    def evaluate(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
+        s = self.strip
+        x = q[self.node_dofs]
+        t, d1, m1, m2, m_ref = self.frames(q)
+        edges = x[1:] - x[:-1]
+        e_s, g_s, h_s = stretching_energy(edges, self.rest_edge_lengths, self.stretch_stiffness,
+                                          gradient=gradient, hessian=hessian)
+        geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
+        e_b, g_b, h_b = bending_energy(geom, self.voronoi_lengths, s.bending_stiffness,
+                                       s.geodesic_bending_stiffness, gradient=gradient, hessian=hessian)
+        theta = q[self.theta_dofs]
+        tau = theta[1:] - theta[:-1] + m_ref
+        if gradient:
+            g_tau, h_tau = twist_derivatives(geom, hessian=hessian)
+        else:
+            g_tau = h_tau = None
+        e_t, g_t, h_t = twisting_energy(tau, self.voronoi_lengths, s.twisting_stiffness, g_tau, h_tau)
+        parts = {"stretching": float(e_s.sum()), "bending": float(e_b.sum()), "twisting": float(e_t.sum())}
+        out = Evaluation(energy=parts["stretching"] + parts["bending"] + parts["twisting"], parts=parts)
+        if not gradient:
+            return out
+        grad = np.zeros(self.n_dof)
+        g_edge, h_edge = two_node_blocks(g_s, h_s if hessian else np.zeros((len(edges), 3, 3)))
+        grad += np.bincount(self._edge_index.ravel(), weights=g_edge.ravel(), minlength=self.n_dof)
+        grad += np.bincount(self._stencil_index.ravel(), weights=(g_b + g_t).ravel(), minlength=self.n_dof)
+        out.gradient = grad
+        if hessian:
+            h7 = np.zeros((len(edges), 7, 7))
+            idx = np.r_[0, 1, 2, 4, 5, 6]
+            h7[:, idx[:, None], idx[None, :]] = h_edge
+            out.hessian = self._assembler.assemble([h7, h_b + h_t])
+        return out
+
+    # ------------------------------------------------------------------ helpers
+    def residual_scale(self) -> np.ndarray:
+        """Per-DOF force/moment units: EI2 / L^2 for positions, EI2 / L for twist angles."""
+        s = self.strip
+        scale = np.full(self.n_dof, s.bending_stiffness / s.length**2)
+        scale[self.theta_dofs] = s.bending_stiffness / s.length
+        return scale
+
+    def length_scale(self) -> np.ndarray:
+        """Per-DOF size used in step tolerances: L for positions, 1 rad for angles."""
+        scale = np.full(self.n_dof, self.strip.length)
+        scale[self.theta_dofs] = 1.0
+        return scale
+
+    def buckled_guess(self, compression: float, direction: int = 1) -> np.ndarray:
+        """An inextensible first-mode shape with chord L - dL, used to start the compression.
+
+        Tangent angles phi_e = phi0 sin(2 pi s_e / L) at the edge stations s_e = e h, with phi0
+        solved so the chord between the clamp points is exactly L - dL; the shape lies in the
+        x-z plane, rising towards +z for direction = +1.
+        """
+        cl = self.centerline
+        h = cl.spacing
+        s_e = cl.edge_arclength
+        shape = np.sin(2.0 * np.pi * s_e / cl.length)
+
+        def chord_error(phi0):
+            c = np.cos(phi0 * shape)
+            return h * (0.5 * c[0] + c[1:-1].sum() + 0.5 * c[-1]) - (cl.length - compression)
+
+        phi0 = brentq(chord_error, 0.0, 2.4) if compression > 0 else 0.0
+        phi = direction * phi0 * shape
+        tangents = np.stack([np.cos(phi), np.zeros_like(phi), np.sin(phi)], axis=1)
+        x = np.zeros((self.nodes, 3))
+        x[0] = [-0.5 * h, 0.0, 0.0]
+        x[1:] = x[0] + h * np.cumsum(tangents, axis=0)
+        q = self.rest_state()
+        q[self.node_dofs] = x
+        return q
+
+    def mass(self) -> np.ndarray:
+        """Lumped masses for the dynamic option (Eq. 7): rho A dl per node, rho I_p dl per edge."""
+        s = self.strip
+        h = self.centerline.spacing
+        mass = np.full(self.n_dof, s.density * s.width * s.thickness * h)
+        polar = s.density * s.width * s.thickness * (s.width**2 + s.thickness**2) / 12.0
+        mass[self.theta_dofs] = polar * h
+        return mass

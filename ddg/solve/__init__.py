@@ -1,0 +1,1 @@
+"""Assembly, Newton, continuation and stability: no physics lives here."""

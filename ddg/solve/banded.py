@@ -1,0 +1,113 @@
+"""Symmetric banded matrices (lower storage) for the rod: assembly, Cholesky, eigenvalues.
+
+Storage follows LAPACK's lower band form: band[d, j] = A[j + d, j] for 0 <= d <= bandwidth.
+The rod's DOF vector (Eq. 1) interleaves positions and twists so that every element touches
+a contiguous block of at most 11 DOFs: the Hessian has bandwidth 10 and Newton costs O(M).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+
+class BandAssembler:
+    """Precomputed scatter indices from dense element blocks to lower band storage.
+
+    Each element type is a family of (m x m) blocks placed at DOF offsets `offsets`; the
+    flat target index of entry (a, b), a >= b, of block k is (a - b) * n + offsets[k] + b.
+    """
+
+    def __init__(self, n: int, bandwidth: int):
+        self.n = n
+        self.bandwidth = bandwidth
+        self._families: list[tuple[np.ndarray, np.ndarray]] = []
+
+    def add_family(self, offsets: np.ndarray, size: int) -> int:
+        a, b = np.tril_indices(size)
+        if np.any(a - b > self.bandwidth):
+            raise ValueError("element block wider than the band")
+        flat = (a - b)[None, :] * self.n + offsets[:, None] + b[None, :]
+        local = a * size + b
+        self._families.append((flat.ravel(), local))
+        return len(self._families) - 1
+
+    def assemble(self, blocks: list[np.ndarray]) -> "SymmetricBanded":
+        total = np.zeros((self.bandwidth + 1) * self.n)
+        for (flat, local), values in zip(self._families, blocks):
+            m = values.shape[1]
+            total += np.bincount(flat, weights=values.reshape(-1, m * m)[:, local].ravel(), minlength=total.size)
+        return SymmetricBanded(total.reshape(self.bandwidth + 1, self.n))
+
+
+class SymmetricBanded:
+    """A symmetric matrix in lower band storage with the operations the solvers need."""
+
+    def __init__(self, band: np.ndarray):
+        self.band = band
+        self._cholesky = None
+        self._cholesky_tried = False
+
+    @property
+    def n(self) -> int:
+        return self.band.shape[1]
+
+    def restrict(self, start: int, stop: int) -> "SymmetricBanded":
+        """The principal sub-matrix on DOFs start..stop-1 (the free block of the rod)."""
+        band = self.band[:, start:stop].copy()
+        m = stop - start
+        for d in range(1, band.shape[0]):
+            band[d, m - d:] = 0.0
+        return SymmetricBanded(band)
+
+    def shifted(self, shift: float) -> "SymmetricBanded":
+        band = self.band.copy()
+        band[0] += shift
+        return SymmetricBanded(band)
+
+    def matvec(self, x: np.ndarray) -> np.ndarray:
+        y = self.band[0] * x
+        for d in range(1, self.band.shape[0]):
+            col = self.band[d, : self.n - d]
+            y[d:] += col * x[: self.n - d]
+            y[: self.n - d] += col * x[d:]
+        return y
+
+    def cholesky(self) -> bool:
+        """Try a banded Cholesky; success proves the matrix positive definite."""
+        if not self._cholesky_tried:
+            self._cholesky_tried = True
+            try:
+                self._cholesky = sla.cholesky_banded(self.band, lower=True, check_finite=False)
+            except sla.LinAlgError:
+                self._cholesky = None
+        return self._cholesky is not None
+
+    @property
+    def positive_definite(self) -> bool:
+        return self.cholesky()
+
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        if self.cholesky():
+            return sla.cho_solve_banded((self._cholesky, True), rhs, check_finite=False)
+        u = self.band.shape[0] - 1
+        full = np.zeros((2 * u + 1, self.n))
+        full[u:] = self.band
+        for d in range(1, u + 1):
+            full[u - d, d:] = self.band[d, : self.n - d]
+        return sla.solve_banded((u, u), full, rhs, check_finite=False)
+
+    def lowest_eigenpairs(self, count: int = 1, vectors: bool = False):
+        """The `count` lowest eigenvalues (and eigenvectors) by LAPACK's banded solver."""
+        count = min(count, self.n)
+        result = sla.eig_banded(
+            self.band, lower=True, eigvals_only=not vectors, select="i",
+            select_range=(0, count - 1), check_finite=False,
+        )
+        return result
+
+    def to_dense(self) -> np.ndarray:
+        a = np.diag(self.band[0])
+        for d in range(1, self.band.shape[0]):
+            off = np.diag(self.band[d, : self.n - d], -d)
+            a += off + off.T
+        return a

@@ -13,7 +13,10 @@ from .rod_curvature import StencilGeometry, curvature_derivatives
 
 def bending_energy(g: StencilGeometry, voronoi_lengths, bending_stiffness, geodesic_bending_stiffness,
                    *, gradient=True, hessian=True):
-    """E_b per node, stencil gradient (n, 11) and symmetric Hessian (n, 11, 11)."""
+    """E_b per node, stencil gradient (n, 11) and symmetric Hessian (n, 11, 11).
+
+    The Hessian is 1/dl [EI2 (grad kn grad kn^T + kn hess kn) + EI1 (same for kg)].
+    """
     (kn, gn, hn), (kg, gg, hg) = curvature_derivatives(g, hessian=hessian and gradient)
     a = bending_stiffness / voronoi_lengths
     c = geodesic_bending_stiffness / voronoi_lengths
@@ -23,8 +26,13 @@ def bending_energy(g: StencilGeometry, voronoi_lengths, bending_stiffness, geode
     grad = (a * kn)[:, None] * gn + (c * kg)[:, None] * gg
     if not hessian:
         return energy, grad, None
-    hess = a[:, None, None] * (gn[:, :, None] * gn[:, None, :] + kn[:, None, None] * hn) + c[:, None, None] * (
-        gg[:, :, None] * gg[:, None, :] + kg[:, None, None] * hg
-    )
-    hess = 0.5 * (hess + hess.transpose(0, 2, 1))
+    hess = curvature_hessian_terms(hn, hg, a * kn, c * kg)
+    hess += a[:, None, None] * (gn[:, :, None] * gn[:, None, :]) + c[:, None, None] * (gg[:, :, None] * gg[:, None, :])
     return energy, grad, hess
+
+
+def curvature_hessian_terms(hn, hg, weight_n, weight_g, extra=()):
+    """sum of weight * Hessian(kappa) terms (plus `extra` (StencilHessian, weight) pairs), mapped to 11x11."""
+    others = [hg] + [h for h, _ in extra]
+    weights = [weight_n, weight_g] + [w for _, w in extra]
+    return hn.scaled_sum(weights, others).to_stencil()

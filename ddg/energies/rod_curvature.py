@@ -33,6 +33,9 @@ _NODE = (slice(0, 3), slice(4, 7), slice(8, 11))
 _EDGE_SIGN = np.array([[-1.0, 0.0], [1.0, -1.0], [0.0, 1.0]])
 
 
+_EYE = np.eye(3)
+
+
 def _outer(a, b):
     return a[:, :, None] * b[:, None, :]
 
@@ -56,28 +59,62 @@ def _scatter_edges(grad_e, grad_f, out):
     out[:, XF] = grad_f
 
 
-def _scatter_edge_hessian(h_ee, h_ef, h_ff, out):
-    """Position-position blocks of an (n, 11, 11) stencil Hessian from d2/de2, d2/dedf, d2/df2."""
-    blocks = ((h_ee, h_ef), (h_ef.transpose(0, 2, 1), h_ff))
-    for a, sa in enumerate(_NODE):
-        for b, sb in enumerate(_NODE):
+class StencilHessian:
+    """Second derivatives of a stencil quantity in edge form, before mapping to the 11 DOFs.
+
+    ee, ef, ff: (n, 3, 3) blocks d2/de2, d2/de df, d2/df2; e_theta, f_theta: (n, 3, 2)
+    mixed blocks with (theta^{i-1}, theta^i); theta_theta: (n, 2) diagonal twist block.
+    Linear combinations are formed in this compact form and mapped to (n, 11, 11) once.
+    """
+
+    __slots__ = ("ee", "ef", "ff", "e_theta", "f_theta", "theta_theta")
+
+    def __init__(self, ee, ef, ff, e_theta, f_theta, theta_theta):
+        self.ee, self.ef, self.ff = ee, ef, ff
+        self.e_theta, self.f_theta, self.theta_theta = e_theta, f_theta, theta_theta
+
+    def scaled_sum(self, weights, others=()):
+        """sum_k w_k H_k with weights (n,) arrays: self * weights[0] + others[k] * weights[k+1]."""
+        terms = [(self, weights[0])] + [(h, w) for h, w in zip(others, weights[1:])]
+        out = []
+        for name in self.__slots__:
             acc = 0.0
-            for p in range(2):
-                for q in range(2):
-                    w = _EDGE_SIGN[a, p] * _EDGE_SIGN[b, q]
-                    if w != 0.0:
-                        acc = acc + w * blocks[p][q]
-            out[:, sa, sb] = acc
+            for h, w in terms:
+                value = getattr(h, name)
+                if value is None:
+                    continue
+                acc = acc + w.reshape((-1,) + (1,) * (value.ndim - 1)) * value
+            out.append(acc)
+        return StencilHessian(*out)
 
-
-def _scatter_edge_theta(h_e_theta, h_f_theta, column, out):
-    """Mixed position-twist blocks: d2/de dtheta, d2/df dtheta (n, 3) into column `column`."""
-    out[:, XE, column] = -h_e_theta
-    out[:, XI, column] = h_e_theta - h_f_theta
-    out[:, XF, column] = h_f_theta
-    out[:, column, XE] = -h_e_theta
-    out[:, column, XI] = h_e_theta - h_f_theta
-    out[:, column, XF] = h_f_theta
+    def to_stencil(self) -> np.ndarray:
+        """The (n, 11, 11) Hessian in stencil DOF order (e = x_i - x_{i-1}, f = x_{i+1} - x_i)."""
+        n = self.ee.shape[0]
+        ee, ef, ff = self.ee, self.ef, self.ff
+        fe = ef.transpose(0, 2, 1)
+        hess = np.empty((n, 11, 11))
+        hess[:, XE, XE] = ee
+        hess[:, XE, XI] = ef - ee
+        hess[:, XE, XF] = -ef
+        hess[:, XI, XE] = fe - ee
+        hess[:, XI, XI] = ee - ef - fe + ff
+        hess[:, XI, XF] = ef - ff
+        hess[:, XF, XE] = -fe
+        hess[:, XF, XI] = fe - ff
+        hess[:, XF, XF] = ff
+        for col, c in ((TE, 0), (TF, 1)):
+            e_t, f_t = self.e_theta[:, :, c], self.f_theta[:, :, c]
+            hess[:, XE, col] = -e_t
+            hess[:, XI, col] = e_t - f_t
+            hess[:, XF, col] = f_t
+            hess[:, col, XE] = -e_t
+            hess[:, col, XI] = e_t - f_t
+            hess[:, col, XF] = f_t
+        hess[:, TE, TE] = self.theta_theta[:, 0]
+        hess[:, TF, TF] = self.theta_theta[:, 1]
+        hess[:, TE, TF] = 0.0
+        hess[:, TF, TE] = 0.0
+        return hess
 
 
 class StencilGeometry:
@@ -104,7 +141,7 @@ def material_curvatures(g: StencilGeometry) -> tuple[np.ndarray, np.ndarray]:
 
 
 def curvature_derivatives(g: StencilGeometry, hessian: bool = True):
-    """Values, gradients (n, 11) and Hessians (n, 11, 11) of kappa_n and kappa_g."""
+    """[(kappa, gradient (n, 11), StencilHessian)] for kappa_n and kappa_g."""
     n = g.e.shape[0]
     kappa_n, kappa_g = material_curvatures(g)
     chi = g.chi
@@ -133,33 +170,31 @@ def curvature_derivatives(g: StencilGeometry, hessian: bool = True):
         if not hessian:
             out.append((kappa, grad, None))
             continue
-        hess = np.zeros((n, 11, 11))
         k3 = kappa[:, None, None]
         chi3 = chi[:, None, None]
         tt_tt = _outer(tt, tt)
         tf_c = cross(g.tf, dt)
         te_c = cross(g.te, dt)
-        h_ee = (inv_e**2)[:, None, None] * (
-            2.0 * k3 * tt_tt - sgn * (_outer(tf_c, tt) + _outer(tt, tf_c))
-        ) - k3 / chi3 * (inv_e**2)[:, None, None] * (np.eye(3) - _outer(g.te, g.te)) + sgn * (
-            0.25 * inv_e**2
-        )[:, None, None] * (_outer(g.kb, me) + _outer(me, g.kb))
-        h_ff = (inv_f**2)[:, None, None] * (
-            2.0 * k3 * tt_tt + sgn * (_outer(te_c, tt) + _outer(tt, te_c))
-        ) - k3 / chi3 * (inv_f**2)[:, None, None] * (np.eye(3) - _outer(g.tf, g.tf)) + sgn * (
-            0.25 * inv_f**2
-        )[:, None, None] * (_outer(g.kb, mf) + _outer(mf, g.kb))
-        h_ef = -k3 / (chi3 * (g.norm_e * g.norm_f)[:, None, None]) * (np.eye(3) + _outer(g.te, g.tf)) + (
-            (inv_e * inv_f)[:, None, None]
-        ) * (2.0 * k3 * tt_tt - sgn * _outer(tf_c, tt) + sgn * _outer(tt, te_c) - sgn * _skew(dt))
-        _scatter_edge_hessian(h_ee, h_ef, h_ff, hess)
-        # twist-twist
-        hess[:, TE, TE] = -sgn * 0.5 * rowdot(g.kb, me)
-        hess[:, TF, TF] = -sgn * 0.5 * rowdot(g.kb, mf)
-        # position-twist
-        for column, m in ((TE, ga[0]), (TF, ga[1])):
-            h_e = inv_e[:, None] * (0.5 * rowdot(g.kb, m)[:, None] * tt - cross(g.tf, m) / chi[:, None])
-            h_f = inv_f[:, None] * (0.5 * rowdot(g.kb, m)[:, None] * tt + cross(g.te, m) / chi[:, None])
-            _scatter_edge_theta(h_e, h_f, column, hess)
+        inv_e2 = (inv_e**2)[:, None, None]
+        inv_f2 = (inv_f**2)[:, None, None]
+        h_ee = inv_e2 * (2.0 * k3 * tt_tt - sgn * (_outer(tf_c, tt) + _outer(tt, tf_c))
+                         - k3 / chi3 * (_EYE - _outer(g.te, g.te))
+                         + 0.25 * sgn * (_outer(g.kb, me) + _outer(me, g.kb)))
+        h_ff = inv_f2 * (2.0 * k3 * tt_tt + sgn * (_outer(te_c, tt) + _outer(tt, te_c))
+                         - k3 / chi3 * (_EYE - _outer(g.tf, g.tf))
+                         + 0.25 * sgn * (_outer(g.kb, mf) + _outer(mf, g.kb)))
+        h_ef = (inv_e * inv_f)[:, None, None] * (
+            -k3 / chi3 * (_EYE + _outer(g.te, g.tf))
+            + 2.0 * k3 * tt_tt - sgn * _outer(tf_c, tt) + sgn * _outer(tt, te_c) - sgn * _skew(dt)
+        )
+        # position-twist: d2 kappa / de dtheta and d2 kappa / df dtheta
+        kb_m = np.stack([rowdot(g.kb, ga[0]), rowdot(g.kb, ga[1])], axis=1)  # (n, 2)
+        e_theta = np.empty((n, 3, 2))
+        f_theta = np.empty((n, 3, 2))
+        for c, m in enumerate(ga):
+            e_theta[:, :, c] = inv_e[:, None] * (0.5 * kb_m[:, c, None] * tt - cross(g.tf, m) / chi[:, None])
+            f_theta[:, :, c] = inv_f[:, None] * (0.5 * kb_m[:, c, None] * tt + cross(g.te, m) / chi[:, None])
+        theta_theta = -sgn * 0.5 * np.stack([rowdot(g.kb, me), rowdot(g.kb, mf)], axis=1)
+        hess = StencilHessian(h_ee, h_ef, h_ff, e_theta, f_theta, theta_theta)
         out.append((kappa, grad, hess))
     return out

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rod_curvature import TE, TF, StencilGeometry, _outer, _scatter_edge_hessian, _scatter_edges, _skew
+from .rod_curvature import TE, TF, StencilGeometry, StencilHessian, _outer, _scatter_edges, _skew
 
 
 def twist_derivatives(g: StencilGeometry, hessian: bool = True):
-    """Gradient (n, 11) and Hessian (n, 11, 11) of the discrete twist tau."""
+    """Gradient (n, 11) and Hessian (StencilHessian; the twist is linear in theta) of tau."""
     n = g.e.shape[0]
     grad = np.zeros((n, 11))
     _scatter_edges(0.5 * g.kb / g.norm_e[:, None], 0.5 * g.kb / g.norm_f[:, None], grad)
@@ -30,9 +30,8 @@ def twist_derivatives(g: StencilGeometry, hessian: bool = True):
     h_ee = -0.25 * inv_e2 * (_outer(g.kb, a_e) + _outer(a_e, g.kb))
     h_ff = -0.25 * inv_f2 * (_outer(g.kb, a_f) + _outer(a_f, g.kb))
     h_ef = 0.5 * inv_ef * ((_skew(g.te) + _skew(g.tf)) / chi3 - 0.5 * (_outer(g.kb, g.tilde_t) + _outer(g.tilde_t, g.kb)))
-    hess = np.zeros((n, 11, 11))
-    _scatter_edge_hessian(h_ee, h_ef, h_ff, hess)
-    return grad, hess
+    zero = np.zeros((n, 3, 2))
+    return grad, StencilHessian(h_ee, h_ef, h_ff, zero, zero, np.zeros((n, 2)))
 
 
 def twisting_energy(tau, voronoi_lengths, twisting_stiffness, grad_tau=None, hess_tau=None):
@@ -44,5 +43,6 @@ def twisting_energy(tau, voronoi_lengths, twisting_stiffness, grad_tau=None, hes
     grad = (k * tau)[:, None] * grad_tau
     if hess_tau is None:
         return energy, grad, None
-    hess = k[:, None, None] * (grad_tau[:, :, None] * grad_tau[:, None, :] + tau[:, None, None] * hess_tau)
+    hess = k[:, None, None] * (grad_tau[:, :, None] * grad_tau[:, None, :])
+    hess += hess_tau.scaled_sum([k * tau]).to_stencil()
     return energy, grad, hess

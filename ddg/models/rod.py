@@ -15,7 +15,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..energies.rod_bending import bending_energy
-from ..energies.rod_curvature import StencilGeometry
+from ..energies.rod_curvature import StencilGeometry, curvature_derivatives
 from ..energies.rod_twist import twist_derivatives, twisting_energy
 from ..energies.stretch import stretching_energy, two_node_blocks
 from ..geometry.centerline import Centerline
@@ -32,6 +32,7 @@ class Evaluation:
     gradient: np.ndarray | None = None
     hessian: SymmetricBanded | None = None
     parts: dict | None = None
+    frames: tuple | None = None  # (tangents, d1, m_ref) of the evaluated state
 
 
 class RodModel:
@@ -88,9 +89,12 @@ class RodModel:
         m_ref = reference_twist(d1, t, self._ref_twist)
         return t, d1, m1, m2, m_ref
 
-    def commit(self, q: np.ndarray) -> None:
+    def commit(self, q: np.ndarray, evaluation: Evaluation | None = None) -> None:
         """Adopt q's frames as the reference from which the next trial states are transported."""
-        t, d1, _, _, m_ref = self.frames(q)
+        if evaluation is not None and evaluation.frames is not None:
+            t, d1, m_ref = evaluation.frames
+        else:
+            t, d1, _, _, m_ref = self.frames(q)
         self._tangents, self._d1, self._ref_twist = t, d1, m_ref
 
     def save_frames(self):
@@ -114,6 +118,17 @@ class RodModel:
         q[self.constrained] = self.clamp_values(compression, shear)
         return q
 
+    def midpoint(self, q: np.ndarray) -> np.ndarray:
+        """Centerline point at rest arclength s = L/2 (linear along the edge, O(h^2))."""
+        return self.centerline.interpolate_at(q[self.node_dofs], 0.5 * self.strip.length)
+
+    def mode_sign(self, mode: np.ndarray, direction: int) -> float:
+        """Sign convention of a mode: +1 raises the midpoint (direction=1) or the first half
+        of the strip against the second (direction=0, the '+' branches US+ and S+)."""
+        z = mode[self.node_dofs][:, 2]
+        at = lambda frac: float(self.centerline.interpolate_at(z, frac * self.strip.length))
+        return at(0.5) if direction else at(0.25) - at(0.75)
+
     def clamp_force(self, gradient: np.ndarray) -> np.ndarray:
         """Force (N) the moving clamp at s = L applies to the strip: dE/d(clamp translation)."""
         g = gradient[self.node_dofs]
@@ -128,17 +143,19 @@ class RodModel:
         e_s, g_s, h_s = stretching_energy(edges, self.rest_edge_lengths, self.stretch_stiffness,
                                           gradient=gradient, hessian=hessian)
         geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
-        e_b, g_b, h_b = bending_energy(geom, self.voronoi_lengths, s.bending_stiffness,
-                                       s.geodesic_bending_stiffness, gradient=gradient, hessian=hessian)
         theta = q[self.theta_dofs]
         tau = theta[1:] - theta[:-1] + m_ref
-        if gradient:
-            g_tau, h_tau = twist_derivatives(geom, hessian=hessian)
+        if hessian and gradient:
+            e_b, e_t, g_b, g_t, h_bt = self._bend_twist_fused(geom, tau)
+            h_b, h_t = h_bt, 0.0
         else:
-            g_tau = h_tau = None
-        e_t, g_t, h_t = twisting_energy(tau, self.voronoi_lengths, s.twisting_stiffness, g_tau, h_tau)
+            e_b, g_b, h_b = bending_energy(geom, self.voronoi_lengths, s.bending_stiffness,
+                                           s.geodesic_bending_stiffness, gradient=gradient, hessian=False)
+            g_tau = twist_derivatives(geom, hessian=False)[0] if gradient else None
+            e_t, g_t, h_t = twisting_energy(tau, self.voronoi_lengths, s.twisting_stiffness, g_tau, None)
         parts = {"stretching": float(e_s.sum()), "bending": float(e_b.sum()), "twisting": float(e_t.sum())}
-        out = Evaluation(energy=parts["stretching"] + parts["bending"] + parts["twisting"], parts=parts)
+        out = Evaluation(energy=parts["stretching"] + parts["bending"] + parts["twisting"], parts=parts,
+                         frames=(t, d1, m_ref))
         if not gradient:
             return out
         grad = np.zeros(self.n_dof)
@@ -153,6 +170,51 @@ class RodModel:
             out.hessian = self._assembler.assemble([h7, h_b + h_t])
         return out
 
+    def _bend_twist_fused(self, geom: StencilGeometry, tau: np.ndarray):
+        """Bending (Eq. 6b) and twisting (Eq. 6c) with one mapping of their Hessians to 11x11.
+
+        Same result as rod_bending.bending_energy + rod_twist.twisting_energy (tested), but
+        the curvature and twist second-derivative terms are summed in edge form first.
+        """
+        s = self.strip
+        (kn, gn, hn), (kg, gg, hg) = curvature_derivatives(geom)
+        g_tau, h_tau = twist_derivatives(geom)
+        a = s.bending_stiffness / self.voronoi_lengths
+        c = s.geodesic_bending_stiffness / self.voronoi_lengths
+        k = s.twisting_stiffness / self.voronoi_lengths
+        e_b = 0.5 * (a * kn**2 + c * kg**2)
+        e_t = 0.5 * k * tau**2
+        g_b = (a * kn)[:, None] * gn + (c * kg)[:, None] * gg
+        g_t = (k * tau)[:, None] * g_tau
+        hess = hn.scaled_sum([a * kn, c * kg, k * tau], [hg, h_tau]).to_stencil()
+        hess += (a[:, None, None] * (gn[:, :, None] * gn[:, None, :]) + c[:, None, None] * (gg[:, :, None] * gg[:, None, :])
+                 + k[:, None, None] * (g_tau[:, :, None] * g_tau[:, None, :]))
+        return e_b, e_t, g_b, g_t, hess
+
+    # ------------------------------------------------------------------ linear algebra
+    def free_matrix(self, hessian: SymmetricBanded) -> SymmetricBanded:
+        """Hessian restricted to the free DOFs (a contiguous block of the band)."""
+        return hessian.restrict(self.free.start, self.free.stop)
+
+    def coupling(self, hessian: SymmetricBanded, dq_constrained: np.ndarray) -> np.ndarray:
+        """H_fc dq_c: the force change on the free DOFs from moving the clamps by dq_c."""
+        dq = np.zeros(self.n_dof)
+        dq[self.constrained] = dq_constrained
+        return hessian.matvec(dq)[self.free]
+
+    def eigenvalue_metric(self) -> tuple[np.ndarray, float]:
+        """Lumped metric D of the free DOFs and the unit of the normalised eigenvalue.
+
+        lambda_min is the lowest eigenvalue of K v = lambda D v with D = h per position DOF and
+        h W^2 / 12 per twist angle (the cross-section's rotational inertia per unit area), in
+        units of EI2 / L^4: lambda L^4 / EI2 approximates the continuum Rayleigh quotient and
+        so does not depend on M. The plate uses area / W per node, making the two comparable.
+        """
+        h = self.centerline.spacing
+        metric = np.full(self.n_dof, h)
+        metric[self.theta_dofs] = h * self.strip.width**2 / 12.0
+        return metric[self.free], self.strip.bending_stiffness / self.strip.length**4
+
     # ------------------------------------------------------------------ helpers
     def residual_scale(self) -> np.ndarray:
         """Per-DOF force/moment units: EI2 / L^2 for positions, EI2 / L for twist angles."""
@@ -160,6 +222,13 @@ class RodModel:
         scale = np.full(self.n_dof, s.bending_stiffness / s.length**2)
         scale[self.theta_dofs] = s.bending_stiffness / s.length
         return scale
+
+    def residual_floor(self) -> float:
+        """Scaled residual that round-off alone produces: stretching forces EA L / h times the
+        machine epsilon, in units of EI2 / L^2, times a safety factor of 10."""
+        s = self.strip
+        floor = np.finfo(float).eps * s.stretching_stiffness * s.length / self.centerline.spacing
+        return 10.0 * floor / (s.bending_stiffness / s.length**2)
 
     def length_scale(self) -> np.ndarray:
         """Per-DOF size used in step tolerances: L for positions, 1 rad for angles."""

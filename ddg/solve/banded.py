@@ -59,6 +59,9 @@ class SymmetricBanded:
             band[d, m - d:] = 0.0
         return SymmetricBanded(band)
 
+    def mean_diagonal(self) -> float:
+        return float(np.mean(np.abs(self.band[0])))
+
     def shifted(self, shift: float) -> "SymmetricBanded":
         band = self.band.copy()
         band[0] += shift
@@ -97,8 +100,22 @@ class SymmetricBanded:
         return sla.solve_banded((u, u), full, rhs, check_finite=False)
 
     def lowest_eigenpairs(self, count: int = 1, vectors: bool = False):
-        """The `count` lowest eigenvalues (and eigenvectors) by LAPACK's banded solver."""
+        """The `count` lowest eigenvalues (and eigenvectors).
+
+        Positive definite (Cholesky succeeded): Lanczos on the inverse, O(n) per iteration,
+        exact for the lowest eigenvalues because all are positive. Otherwise LAPACK's banded
+        eigensolver (dsbevx), O(n^2) but used only on unstable states.
+        """
         count = min(count, self.n)
+        if self.cholesky() and self.n > 4 * count + 20:
+            from scipy.sparse.linalg import LinearOperator, eigsh
+
+            inverse = LinearOperator((self.n, self.n), matvec=self.solve, dtype=float)
+            mu, v = eigsh(inverse, k=count, which="LA", tol=1e-12, ncv=min(self.n, max(2 * count + 1, 20)),
+                          v0=np.ones(self.n))
+            order = np.argsort(-mu)
+            w = 1.0 / mu[order]
+            return (w, v[:, order]) if vectors else w
         result = sla.eig_banded(
             self.band, lower=True, eigvals_only=not vectors, select="i",
             select_range=(0, count - 1), check_finite=False,
@@ -111,3 +128,10 @@ class SymmetricBanded:
             off = np.diag(self.band[d, : self.n - d], -d)
             a += off + off.T
         return a
+
+    def scaled(self, s: np.ndarray) -> "SymmetricBanded":
+        """diag(s) A diag(s), still banded (used to normalise eigenvalues)."""
+        band = self.band * s[None, :]
+        for d in range(band.shape[0]):
+            band[d, : self.n - d] *= s[d:]
+        return SymmetricBanded(band)

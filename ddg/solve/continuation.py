@@ -1,0 +1,173 @@
+"""Quasi-static continuation of the clamp displacement with adaptive load steps.
+
+The load is the clamp translation (dL, dW). Between recorded equilibria the solver takes
+substeps: a tangent predictor (the linear response of the free DOFs to the clamp motion,
+H_ff dq_f = -H_fc dq_c) followed by Newton; a failed substep is undone and halved, an easy
+one (few Newton iterations) lets the next grow. Compression starts from an inextensible
+first-mode guess, so the solver lands on the buckled branch, and every converged state is
+checked by a Cholesky factorisation of the free-DOF Hessian: where it fails during
+compression the solver descends along the negative eigenvector (branch selection), and past
+a pitchfork during shear it switches to the stable branch the same way (if enabled).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .newton import NewtonOptions, newton
+from .stability import lowest_modes
+
+
+class ContinuationFailure(RuntimeError):
+    """The path could not be continued; the message says where."""
+
+
+@dataclass
+class ContinuationOptions:
+    newton: NewtonOptions = field(default_factory=NewtonOptions)
+    min_substep: float = 1.0 / 4096   # smallest substep, as a fraction of a recorded interval
+    easy_iterations: int = 4           # substeps converging this fast let the next one double
+    branch_switching: bool = True      # leave unstable equilibria along the negative eigenvector
+    eigenvalues: bool = True           # compute lambda_min at every recorded equilibrium
+    kick: float = 1e-3                 # size of the push off an unstable state, relative to L
+    jump_substep: float = 1.0 / 64     # below this substep a failing branch is left by energy descent
+
+
+@dataclass
+class State:
+    q: np.ndarray
+    evaluation: object
+    compression: float
+    shear: float
+    stable: bool
+    iterations: int = 0
+    branch_switched: bool = False
+
+
+class PathFollower:
+    def __init__(self, model, options: ContinuationOptions | None = None):
+        self.model = model
+        self.options = options or ContinuationOptions()
+        self.substep = 1.0
+        self.newton_iterations = 0
+
+    # ------------------------------------------------------------------ pieces
+    def rest(self) -> State:
+        q = self.model.reset()
+        ev = self.model.evaluate(q)
+        stable = self.model.free_matrix(ev.hessian).cholesky()
+        return State(q, ev, 0.0, 0.0, stable)
+
+    def start_compression(self, compression: float, direction: int = 1) -> State:
+        """First buckled equilibrium at a small compression, from an inextensible guess."""
+        model = self.model
+        for attempt in range(12):
+            model.reset()
+            q = model.apply_clamps(model.buckled_guess(compression, direction), compression, 0.0)
+            model.commit(q)
+            result = newton(model, q, self.options.newton, minimize=True)
+            self.newton_iterations += result.iterations
+            if result.converged:
+                state = State(result.q, result.evaluation, compression, 0.0, bool(result.positive_definite),
+                              result.iterations)
+                return self._ensure_stable(state, direction)
+            compression *= 0.5
+        raise ContinuationFailure("could not find the buckled state at the start of compression")
+
+    def advance(self, state: State, compression: float, shear: float) -> State:
+        """Continue from `state` to the clamp displacement (compression, shear)."""
+        start = np.array([state.compression, state.shear])
+        target = np.array([compression, shear])
+        t = 0.0
+        iterations = 0
+        switched = False
+        while t < 1.0:
+            t_next = min(1.0, t + self.substep)
+            load = start + t_next * (target - start)
+            new = self._step(state, *load)
+            if new is None and self.options.branch_switching and self.substep <= self.options.jump_substep:
+                # the branch has ended (a fold): let the strip snap to the nearest stable state
+                new = self._jump(state, *load)
+            if new is None:
+                self.substep *= 0.5
+                if self.substep < self.options.min_substep:
+                    raise ContinuationFailure(
+                        f"Newton failed to converge beyond dL/L = {state.compression / self._length:.6g}, "
+                        f"dW/L = {state.shear / self._length:.6g} (substep below {self.options.min_substep:g} "
+                        "of a recorded interval)"
+                    )
+                continue
+            iterations += new.iterations
+            switched = switched or new.branch_switched
+            if new.iterations <= self.options.easy_iterations:
+                self.substep = min(1.0, 2.0 * self.substep)
+            state, t = new, t_next
+        state.iterations = iterations
+        state.branch_switched = switched
+        return state
+
+    @property
+    def _length(self) -> float:
+        return self.model.strip.length
+
+    def _step(self, state: State, compression: float, shear: float) -> State | None:
+        model = self.model
+        saved = model.save_frames()
+        new_clamps = model.clamp_values(compression, shear)
+        dq_c = new_clamps - state.q[model.constrained]
+        K = model.free_matrix(state.evaluation.hessian)
+        q = state.q.copy()
+        q[model.constrained] = new_clamps
+        q[model.free] -= K.solve(model.coupling(state.evaluation.hessian, dq_c))
+        result = newton(model, q, self.options.newton)
+        self.newton_iterations += result.iterations
+        if not result.converged:
+            model.restore_frames(saved)
+            return None
+        new = State(result.q, result.evaluation, compression, shear, bool(result.positive_definite), result.iterations)
+        if not new.stable and self.options.branch_switching:
+            new = self._ensure_stable(new, 0)
+            if new is None:
+                model.restore_frames(saved)
+        return new
+
+    def _jump(self, state: State, compression: float, shear: float) -> State | None:
+        """Quasi-static snap: descend in energy from the predicted state at the new load."""
+        model = self.model
+        saved = model.save_frames()
+        q = model.apply_clamps(state.q, compression, shear)
+        model.commit(q)
+        result = newton(model, q, self.options.newton, minimize=True)
+        self.newton_iterations += result.iterations
+        if result.converged and result.positive_definite:
+            return State(result.q, result.evaluation, compression, shear, True, result.iterations, branch_switched=True)
+        model.restore_frames(saved)
+        return None
+
+    def _ensure_stable(self, state: State, direction: int) -> State | None:
+        """Leave an unstable equilibrium along its lowest mode and descend to a stable one.
+
+        direction = +1: choose the sign that raises the midpoint (compression, the U branch);
+        direction = 0: the sign that raises the first half of the strip against the second
+        (the '+' branch of a pitchfork during shear).
+        """
+        if state.stable:
+            return state
+        model = self.model
+        _, modes = lowest_modes(model, state.evaluation.hessian, 1, vectors=True)
+        mode = np.zeros(model.n_dof)
+        mode[model.free] = modes[:, 0]
+        mode /= np.max(np.abs(mode[model.node_dofs]))
+        sign = 1.0 if model.mode_sign(mode, direction) >= 0 else -1.0
+        for kick in (self.options.kick, 10 * self.options.kick, 0.1 * self.options.kick):
+            saved = model.save_frames()
+            q = state.q + sign * kick * self._length * mode
+            model.commit(q)
+            result = newton(model, q, self.options.newton, minimize=True)
+            self.newton_iterations += result.iterations
+            if result.converged and result.positive_definite:
+                return State(result.q, result.evaluation, state.compression, state.shear, True,
+                             state.iterations + result.iterations, branch_switched=True)
+            model.restore_frames(saved)
+        return None

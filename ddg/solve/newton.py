@@ -1,0 +1,102 @@
+"""Newton's method on the free DOFs with an energy line search.
+
+Model interface used here (rod and plate alike): `n_dof`, `free` (slice or indices),
+`evaluate(q, gradient, hessian)` -> Evaluation(energy, gradient, hessian), `free_matrix(H)`
+-> an operator with cholesky() / solve() / lowest_eigenpairs() / shifted(), `commit(q)`,
+`save_frames()` / `restore_frames()`, `residual_scale()` and `length_scale()`.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class NewtonOptions:
+    max_iterations: int = 25
+    residual_tol: float = 1e-9   # max |dE/dq_i| / (EI2/L^2 or EI2/L), raised to the model's round-off floor
+    step_tol: float = 1e-10      # Newton correction relative to L (positions) or 1 rad (angles)
+    stagnation_residual: float = 1e-3  # the correction test applies only below this residual
+    max_line_search: int = 30
+
+
+@dataclass
+class NewtonResult:
+    q: np.ndarray
+    evaluation: object
+    converged: bool
+    iterations: int
+    residual: float
+    positive_definite: bool | None
+    message: str = ""
+
+
+def scaled_residual(model, gradient: np.ndarray) -> float:
+    free = model.free
+    return float(np.max(np.abs(gradient[free] / model.residual_scale()[free]), initial=0.0))
+
+
+def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimize: bool = False,
+           evaluation=None) -> NewtonResult:
+    """Solve grad E = 0 on the free DOFs starting from q (its clamped DOFs already set).
+
+    With minimize=False the plain Newton step is used, which can also converge to unstable
+    equilibria (needed to follow the symmetric branch past a pitchfork); the line search then
+    uses the energy where the Hessian is positive definite and the residual elsewhere. With
+    minimize=True an indefinite Hessian is shifted to be positive definite (modified Newton),
+    so the iteration descends to a stable equilibrium.
+    """
+    options = options or NewtonOptions()
+    free = model.free
+    rscale = model.residual_scale()[free]
+    lscale = model.length_scale()[free]
+    residual_tol = max(options.residual_tol, model.residual_floor())
+    q = q.copy()
+    ev = evaluation if evaluation is not None else model.evaluate(q)
+    pd = None
+    for iteration in range(options.max_iterations + 1):
+        if not np.all(np.isfinite(ev.gradient)):
+            return NewtonResult(q, ev, False, iteration, np.inf, pd, "non-finite gradient")
+        r = ev.gradient[free]
+        res = float(np.max(np.abs(r / rscale), initial=0.0))
+        K = model.free_matrix(ev.hessian)
+        pd = K.cholesky()
+        if res < residual_tol:
+            return NewtonResult(q, ev, True, iteration, res, pd)
+        if minimize and not pd:
+            lam = float(np.atleast_1d(K.lowest_eigenpairs(1))[0])
+            K = K.shifted(-2.0 * lam + 1e-8 * K.mean_diagonal())
+            use_energy = True
+        else:
+            use_energy = pd
+        dq = -K.solve(r)
+        correction = float(np.max(np.abs(dq / lscale)))
+        if correction < options.step_tol and res < options.stagnation_residual and (pd or not minimize):
+            # the Newton correction from q is below tolerance: q is the equilibrium to within it
+            return NewtonResult(q, ev, True, iteration, res, pd)
+        if iteration == options.max_iterations:
+            break
+        slope = float(r @ dq)
+        alpha = 1.0
+        accepted = False
+        for _ in range(options.max_line_search):
+            q_try = q.copy()
+            q_try[free] += alpha * dq
+            ev_try = model.evaluate(q_try)
+            if np.isfinite(ev_try.energy) and np.all(np.isfinite(ev_try.gradient)):
+                if use_energy:
+                    ok = ev_try.energy <= ev.energy + 1e-4 * alpha * min(slope, 0.0) + 1e-12 * abs(ev.energy)
+                else:
+                    res_try = float(np.max(np.abs(ev_try.gradient[free] / rscale)))
+                    ok = res_try <= (1.0 - 1e-4 * alpha) * res
+                if ok:
+                    accepted = True
+                    break
+            alpha *= 0.5
+        if not accepted:
+            return NewtonResult(q, ev, False, iteration + 1, res, pd, "line search failed")
+        model.commit(q_try, ev_try)
+        q, ev = q_try, ev_try
+    res = scaled_residual(model, ev.gradient)
+    return NewtonResult(q, ev, False, options.max_iterations, res, pd, f"no convergence in {options.max_iterations} iterations")

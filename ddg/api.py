@@ -143,7 +143,7 @@ def simulate(
             state = follower.start_compression(target) if k == 1 else follower.advance(state, target, 0.0)
             record("compression")
         summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
-        for k in range(1, protocol.shear_steps + 1):
+        for k in range(1, protocol.shear_steps + 1 if dW != 0.0 else 1):
             state = follower.advance(state, dL, dW * k / protocol.shear_steps)
             record("shear")
         summary["converged"] = True

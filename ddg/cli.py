@@ -40,6 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--shear-direction", type=int, choices=(1, -1), default=1, help="+1 or -1 (default +1)")
     sim.add_argument("--no-branch-switching", action="store_true",
                      help="stay on the branch the path starts on, even where it is unstable")
+    sim.add_argument("--max-newton-iterations", type=int, default=25, help="per load step (default 25)")
     sim.add_argument("--out", default="out", help="output directory (default ./out)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar or result print-out")
     return parser
@@ -48,12 +49,16 @@ def build_parser() -> argparse.ArgumentParser:
 def cmd_simulate(args) -> int:
     from .api import simulate
     from .solve.continuation import ContinuationOptions
+    from .solve.newton import NewtonOptions
 
     strip = Strip.from_ratios(args.width_ratio, args.compression_ratio, args.slenderness,
                               young_modulus=args.young_modulus, poisson_ratio=args.poisson_ratio)
     protocol = LoadingProtocol(args.compression_ratio, args.shear_ratio, args.compression_steps, args.shear_steps,
                                args.shear_direction)
-    options = ContinuationOptions(branch_switching=not args.no_branch_switching)
+    if args.max_newton_iterations < 1:
+        raise InputError(f"--max-newton-iterations = {args.max_newton_iterations} must be >= 1")
+    options = ContinuationOptions(newton=NewtonOptions(max_iterations=args.max_newton_iterations),
+                                  branch_switching=not args.no_branch_switching)
     result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
                       progress=not args.quiet)
     s = result.summary

@@ -62,6 +62,7 @@ class PathFollower:
     def start_compression(self, compression: float, direction: int = 1) -> State:
         """First buckled equilibrium at a small compression, from an inextensible guess."""
         model = self.model
+        first = compression
         for attempt in range(12):
             model.reset()
             q = model.apply_clamps(model.buckled_guess(compression, direction), compression, 0.0)
@@ -73,7 +74,10 @@ class PathFollower:
                               result.iterations)
                 return self._ensure_stable(state, direction)
             compression *= 0.5
-        raise ContinuationFailure("could not find the buckled state at the start of compression")
+        raise ContinuationFailure(
+            f"Newton failed to find the buckled state at the start of compression (tried dL/L from "
+            f"{first / self._length:.4g} down to {compression / self._length:.4g}); only the flat state at dL/L = 0 converged"
+        )
 
     def advance(self, state: State, compression: float, shear: float) -> State:
         """Continue from `state` to the clamp displacement (compression, shear)."""

@@ -1,0 +1,69 @@
+"""The command line writes the output contract and fails cleanly on bad input."""
+import csv
+import json
+
+import pytest
+
+from ddg.cli import main
+
+CONTRACT_COLUMNS = ["stage", "dL_over_L", "dW_over_L", "H_mid_over_L", "F_shear_norm", "energy", "lambda_min", "phase"]
+CONTRACT_KEYS = {"model", "scene", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
+                 "newton_iterations", "wall_time_s", "converged", "versions"}
+SMALL_RUN = ["simulate", "--model", "rod", "--width-ratio", "0.05", "--compression-ratio", "0.5", "--shear-ratio", "0.1",
+             "--resolution", "20", "--compression-steps", "5", "--shear-steps", "4", "--quiet"]
+
+
+def test_simulate_writes_path_and_summary(tmp_path):
+    assert main(SMALL_RUN + ["--out", str(tmp_path)]) == 0
+    with open(tmp_path / "path.csv") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0][: len(CONTRACT_COLUMNS)] == CONTRACT_COLUMNS
+    assert len(rows) == 1 + 1 + 5 + 4  # header, rest state, compression, shear
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert CONTRACT_KEYS <= set(summary)
+    assert summary["model"] == "rod" and summary["converged"] is True
+    assert summary["scene"]["resolution"] == 20 and summary["scene"]["shear_ratio"] == 0.1
+    assert summary["scene"]["slenderness"] == pytest.approx(150e-3 / 0.127e-3)
+    assert summary["n_dof"] == 4 * 20 - 1
+    assert set(summary["versions"]) >= {"numpy", "scipy", "python", "ddg"}
+    last = dict(zip(rows[0], rows[-1]))
+    assert float(last["dW_over_L"]) == pytest.approx(0.1)
+
+
+@pytest.mark.parametrize("argument, value", [
+    ("--width-ratio", "1.5"), ("--compression-ratio", "1.0"), ("--compression-ratio", "-0.1"),
+    ("--shear-ratio", "0.95"), ("--resolution", "3"), ("--poisson-ratio", "0.5"), ("--slenderness", "0"),
+    ("--model", "spaghetti"), ("--resolution", "many"),
+])
+def test_bad_input_exits_2_with_one_line(argument, value, tmp_path, capsys):
+    args = [a for a in SMALL_RUN]
+    if argument in args:
+        i = args.index(argument)
+        args[i + 1] = value
+    else:
+        args += [argument, value]
+    with pytest.raises(SystemExit) if value == "many" else _no_raise():
+        code = main(args + ["--out", str(tmp_path)])
+        assert code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error:") and err.count("\n") == 1 and "Traceback" not in err
+    assert value in err or argument.lstrip("-").replace("-", "_") in err or "model" in err
+
+
+class _no_raise:
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+
+def test_run_that_stops_converging_exits_3_and_keeps_the_converged_part(tmp_path, capsys):
+    code = main(SMALL_RUN + ["--max-newton-iterations", "1", "--out", str(tmp_path)])
+    assert code == 3
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["converged"] is False and "dL/L" in summary["message"]
+    with open(tmp_path / "path.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) >= 1 and rows[0]["stage"] == "compression"
+    assert "did not complete" in capsys.readouterr().err

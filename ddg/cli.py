@@ -40,7 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--shear-direction", type=int, choices=(1, -1), default=1, help="+1 or -1 (default +1)")
     sim.add_argument("--no-branch-switching", action="store_true",
                      help="stay on the branch the path starts on, even where it is unstable")
-    sim.add_argument("--max-newton-iterations", type=int, default=25, help="per load step (default 25)")
+    sim.add_argument("--max-newton-iterations", type=int, default=15, help="per load step (default 15)")
     sim.add_argument("--out", default="out", help="output directory (default ./out)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar or result print-out")
     return parser

@@ -58,12 +58,25 @@ class _no_raise:
         return False
 
 
-def test_run_that_stops_converging_exits_3_and_keeps_the_converged_part(tmp_path, capsys):
-    code = main(SMALL_RUN + ["--max-newton-iterations", "1", "--out", str(tmp_path)])
+def test_run_that_stops_converging_exits_3_and_keeps_the_converged_part(tmp_path, capsys, monkeypatch):
+    """Newton is made to fail from its 8th call on: the run must stop, say where, keep what converged."""
+    import ddg.solve.continuation as continuation
+
+    real_newton, calls = continuation.newton, []
+
+    def failing_newton(model, q, *args, **kwargs):
+        calls.append(1)
+        result = real_newton(model, q, *args, **kwargs)
+        if len(calls) >= 8:
+            result.converged = False
+        return result
+
+    monkeypatch.setattr(continuation, "newton", failing_newton)
+    code = main(SMALL_RUN + ["--out", str(tmp_path)])
     assert code == 3
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert summary["converged"] is False and "dL/L" in summary["message"]
+    assert summary["converged"] is False and "dL/L" in summary["message"] and "dW/L" in summary["message"]
     with open(tmp_path / "path.csv") as fh:
         rows = list(csv.DictReader(fh))
-    assert len(rows) >= 1 and rows[0]["stage"] == "compression"
+    assert 2 <= len(rows) < 1 + 5 + 4 and rows[0]["stage"] == "compression"
     assert "did not complete" in capsys.readouterr().err

@@ -193,8 +193,12 @@ class RodModel:
 
     # ------------------------------------------------------------------ linear algebra
     def free_matrix(self, hessian: SymmetricBanded) -> SymmetricBanded:
-        """Hessian restricted to the free DOFs (a contiguous block of the band)."""
-        return hessian.restrict(self.free.start, self.free.stop)
+        """Hessian restricted to the free DOFs (a contiguous block of the band), cached on it."""
+        block = getattr(hessian, "_free_block", None)
+        if block is None:
+            block = hessian.restrict(self.free.start, self.free.stop)
+            hessian._free_block = block
+        return block
 
     def coupling(self, hessian: SymmetricBanded, dq_constrained: np.ndarray) -> np.ndarray:
         """H_fc dq_c: the force change on the free DOFs from moving the clamps by dq_c."""

@@ -63,9 +63,15 @@ class SymmetricBanded:
         return float(np.mean(np.abs(self.band[0])))
 
     def shifted(self, shift: float) -> "SymmetricBanded":
+        """A + shift I (cached for the last shift asked, so a trial factorisation is reused)."""
+        cached = getattr(self, "_shifted", None)
+        if cached is not None and cached[0] == shift:
+            return cached[1]
         band = self.band.copy()
         band[0] += shift
-        return SymmetricBanded(band)
+        out = SymmetricBanded(band)
+        self._shifted = (shift, out)
+        return out
 
     def matvec(self, x: np.ndarray) -> np.ndarray:
         y = self.band[0] * x

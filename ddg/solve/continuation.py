@@ -11,7 +11,7 @@ a pitchfork during shear it switches to the stable branch the same way (if enabl
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -89,8 +89,10 @@ class PathFollower:
         while t < 1.0:
             t_next = min(1.0, t + self.substep)
             load = start + t_next * (target - start)
-            new = self._step(state, *load)
-            if new is None and self.options.branch_switching and self.substep <= self.options.jump_substep:
+            # near singular points (thresholds) Newton converges only linearly: allow it more iterations
+            hard = self.substep <= self.options.jump_substep
+            new = self._step(state, *load, patient=hard)
+            if new is None and self.options.branch_switching and hard:
                 # the branch has ended (a fold): let the strip snap to the nearest stable state
                 new = self._jump(state, *load)
             if new is None:
@@ -115,7 +117,7 @@ class PathFollower:
     def _length(self) -> float:
         return self.model.strip.length
 
-    def _step(self, state: State, compression: float, shear: float) -> State | None:
+    def _step(self, state: State, compression: float, shear: float, patient: bool = False) -> State | None:
         model = self.model
         saved = model.save_frames()
         new_clamps = model.clamp_values(compression, shear)
@@ -124,7 +126,10 @@ class PathFollower:
         q = state.q.copy()
         q[model.constrained] = new_clamps
         q[model.free] -= K.solve(model.coupling(state.evaluation.hessian, dq_c))
-        result = newton(model, q, self.options.newton)
+        opts = self.options.newton
+        if patient:
+            opts = replace(opts, max_iterations=4 * opts.max_iterations)
+        result = newton(model, q, opts)
         self.newton_iterations += result.iterations
         if not result.converged:
             model.restore_frames(saved)

@@ -121,3 +121,20 @@ def test_narrow_strip_passes_U_to_US_near_036_and_US_to_S_near_052():
     assert np.all(np.abs(h[dw > dW2 + 0.01]) < 1e-6)
     # before dW1 the midpoint barely drops; between the thresholds it falls to zero
     assert h[dw < 0.3].min() > 0.3 and h[(dw > dW1) & (dw < dW2)].max() < h[0]
+
+
+def test_compression_lands_on_the_stable_buckled_branch_from_either_side():
+    """The start guess only selects the side: buckling down is the exact mirror z -> -z of buckling up."""
+    from ddg.solve.continuation import PathFollower
+
+    strip = ddg.Strip.from_ratios(0.05, 0.25)
+    heights = []
+    for direction in (1, -1):
+        rod = RodModel(strip, 50)
+        state = PathFollower(rod).start_compression(0.02 * strip.length, direction)
+        assert state.stable
+        heights.append(rod.midpoint(state.q)[2])
+    assert heights[0] > 0 and abs(heights[0] + heights[1]) < 1e-12 * strip.length
+    # the straight state at the same compression is an equilibrium but unstable
+    straight = _straight_lowest_eigenvalues(RodModel(strip, 50), 0.02, 1)
+    assert straight[0] < 0

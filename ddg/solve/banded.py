@@ -110,7 +110,8 @@ class SymmetricBanded:
 
         Positive definite (Cholesky succeeded): Lanczos on the inverse, O(n) per iteration,
         exact for the lowest eigenvalues because all are positive. Otherwise LAPACK's banded
-        eigensolver (dsbevx), O(n^2) but used only on unstable states.
+        eigensolver for the values (dsbevx: O(n^2) band reduction, used only on unstable
+        states) and inverse iteration for the vectors.
         """
         count = min(count, self.n)
         if self.cholesky() and self.n > 4 * count + 20:
@@ -122,11 +123,24 @@ class SymmetricBanded:
             order = np.argsort(-mu)
             w = 1.0 / mu[order]
             return (w, v[:, order]) if vectors else w
-        result = sla.eig_banded(
-            self.band, lower=True, eigvals_only=not vectors, select="i",
-            select_range=(0, count - 1), check_finite=False,
-        )
-        return result
+        w = np.atleast_1d(sla.eig_banded(self.band, lower=True, eigvals_only=True, select="i",
+                                         select_range=(0, count - 1), check_finite=False))
+        if not vectors:
+            return w
+        # eigenvectors by inverse iteration just below each eigenvalue (O(n) per iteration;
+        # asking LAPACK for them forms the full orthogonal transform, O(n^3))
+        vecs = np.empty((self.n, count))
+        scale = max(1.0, float(np.max(np.abs(w))))
+        rng = np.random.default_rng(0)
+        for i, lam in enumerate(w):
+            shifted = self.shifted(-(lam - 1e-10 * scale))
+            v = rng.standard_normal(self.n)
+            for _ in range(4):
+                v = shifted.solve(v)
+                v -= vecs[:, :i] @ (vecs[:, :i].T @ v)
+                v /= np.linalg.norm(v)
+            vecs[:, i] = v
+        return w, vecs
 
     def to_dense(self) -> np.ndarray:
         a = np.diag(self.band[0])

@@ -12,7 +12,9 @@ from pathlib import Path
 from .observables import EXTRA_COLUMNS, PATH_COLUMNS
 
 
-def _atomic_write(path: Path, text: str) -> None:
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write text to path via a temporary file in the same folder and os.replace."""
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
@@ -20,6 +22,7 @@ def _atomic_write(path: Path, text: str) -> None:
             fh.write(text)
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, 0o644)  # mkstemp creates 0600
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
@@ -42,7 +45,7 @@ def write_path_csv(path: Path, rows: list[dict]) -> None:
     writer.writerow(columns)
     for row in rows:
         writer.writerow([_format(row.get(c, "")) for c in columns])
-    _atomic_write(Path(path), buf.getvalue())
+    atomic_write_text(Path(path), buf.getvalue())
 
 
 def _json_safe(value):
@@ -56,7 +59,7 @@ def _json_safe(value):
 
 
 def write_summary_json(path: Path, summary: dict) -> None:
-    _atomic_write(Path(path), json.dumps(_json_safe(summary), indent=2, sort_keys=False) + "\n")
+    atomic_write_text(Path(path), json.dumps(_json_safe(summary), indent=2, sort_keys=False) + "\n")
 
 
 def read_path_csv(path: Path) -> list[dict]:

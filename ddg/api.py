@@ -75,6 +75,32 @@ def versions() -> dict:
     return {"ddg": __version__, "python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__}
 
 
+def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resolution: int, model) -> dict:
+    """summary.json before the run: every contract key, inputs with defaults resolved."""
+    L = strip.length
+    return {
+        "model": model_name,
+        "scene": {
+            **strip.as_dict(),
+            **protocol.as_dict(strip),
+            "resolution": resolution,
+            "clamp_convention": "clamped edges straddle the clamp points; free length exactly L",
+        },
+        "H_mid_over_L_compressed": None,
+        "dW_max_over_L": strip.shear_limit(protocol.compression_ratio * L) / L,
+        "dW1_over_L": None,
+        "dW2_over_L": None,
+        "n_dof": model.n_dof,
+        "n_free_dof": int(np.arange(model.n_dof)[model.free].size),
+        "newton_iterations": 0,
+        "wall_time_s": None,
+        "converged": False,
+        "message": "",
+        "lambda_min_normalisation": "lowest eigenvalue of K v = lambda D v (lumped metric D), times L^4 / EI2",
+        "versions": versions(),
+    }
+
+
 def simulate(
     strip: Strip,
     protocol: LoadingProtocol,
@@ -83,12 +109,29 @@ def simulate(
     out: str | Path | None = None,
     options: ContinuationOptions | None = None,
     progress: bool = False,
+    solver: str = "static",
+    dynamic_options=None,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
-    Returns every recorded equilibrium (rows of path.csv) and the summary; writes both to
-    `out` if given, also when the run stops early (the converged part of the path is kept).
+    solver="static" (default): Newton continuation of equilibria; solver="dynamic": the
+    paper's implicit-Euler time marching (Eq. 7) with the clamp moved at a finite speed
+    (rod only; see ddg.solve.dynamics). Returns every recorded equilibrium (rows of
+    path.csv) and the summary; writes both to `out` if given, also when the run stops early
+    (the converged part of the path is kept).
     """
+    if solver not in ("static", "dynamic"):
+        raise InputError(f"solver = {solver!r} is not available; choose 'static' or 'dynamic'")
+    if solver == "dynamic":
+        if model != "rod":
+            raise InputError(f"solver = 'dynamic' is available for model 'rod' only, not {model!r}")
+        from .solve.dynamics import simulate_dynamic
+
+        result = simulate_dynamic(strip, protocol, DEFAULT_RESOLUTION["rod"] if resolution is None else resolution,
+                                  dynamic_options)
+        if out is not None:
+            result.write(out)
+        return result
     if not isinstance(strip, Strip):
         raise InputError(f"strip = {strip!r} must be a ddg.Strip")
     if not isinstance(protocol, LoadingProtocol):
@@ -102,31 +145,10 @@ def simulate(
     L = strip.length
     dL = protocol.compression_ratio * L
     dW = protocol.shear_sign * shear_ratio * L
-    dW_max = strip.shear_limit(dL)
 
     rows: list[dict] = []
     progress_bar = _Progress(protocol.compression_steps + protocol.shear_steps + 1, progress)
-    summary = {
-        "model": model,
-        "scene": {
-            **strip.as_dict(),
-            **protocol.as_dict(strip),
-            "resolution": resolution,
-            "clamp_convention": "clamped edges straddle the clamp points; free length exactly L",
-        },
-        "H_mid_over_L_compressed": None,
-        "dW_max_over_L": dW_max / L,
-        "dW1_over_L": None,
-        "dW2_over_L": None,
-        "n_dof": instance.n_dof,
-        "n_free_dof": int(np.arange(instance.n_dof)[instance.free].size),
-        "newton_iterations": 0,
-        "wall_time_s": None,
-        "converged": False,
-        "message": "",
-        "lambda_min_normalisation": "lowest eigenvalue of K v = lambda D v (lumped metric D), times L^4 / EI2",
-        "versions": versions(),
-    }
+    summary = base_summary(model, strip, protocol, resolution, instance)
     t0 = time.perf_counter()
     state = None
 

@@ -40,6 +40,9 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--shear-direction", type=int, choices=(1, -1), default=1, help="+1 or -1 (default +1)")
     sim.add_argument("--no-branch-switching", action="store_true",
                      help="stay on the branch the path starts on, even where it is unstable")
+    sim.add_argument("--solver", choices=("static", "dynamic"), default="static",
+                     help="static Newton continuation (default) or the paper's implicit-Euler time marching (rod)")
+    sim.add_argument("--clamp-speed", type=float, default=1e-3, help="dynamic solver: clamp speed in m/s (default 1e-3)")
     sim.add_argument("--max-newton-iterations", type=int, default=15, help="per load step (default 15)")
     sim.add_argument("--out", default="out", help="output directory (default ./out)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar or result print-out")
@@ -59,8 +62,15 @@ def cmd_simulate(args) -> int:
         raise InputError(f"--max-newton-iterations = {args.max_newton_iterations} must be >= 1")
     options = ContinuationOptions(newton=NewtonOptions(max_iterations=args.max_newton_iterations),
                                   branch_switching=not args.no_branch_switching)
+    dynamic_options = None
+    if args.solver == "dynamic":
+        from .solve.dynamics import DynamicOptions
+
+        if not args.clamp_speed > 0:
+            raise InputError(f"--clamp-speed = {args.clamp_speed} must be a positive speed in m/s")
+        dynamic_options = DynamicOptions(clamp_speed=args.clamp_speed)
     result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
-                      progress=not args.quiet)
+                      progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options)
     s = result.summary
     if not args.quiet:
         keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",

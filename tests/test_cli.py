@@ -80,3 +80,15 @@ def test_run_that_stops_converging_exits_3_and_keeps_the_converged_part(tmp_path
         rows = list(csv.DictReader(fh))
     assert 2 <= len(rows) < 1 + 5 + 4 and rows[0]["stage"] == "compression"
     assert "did not complete" in capsys.readouterr().err
+
+
+def test_dynamic_solver_writes_the_same_contract(tmp_path):
+    args = ["simulate", "--solver", "dynamic", "--clamp-speed", "0.02", "--resolution", "20", "--compression-ratio",
+            "0.25", "--shear-ratio", "0.05", "--compression-steps", "4", "--shear-steps", "2", "--quiet",
+            "--out", str(tmp_path)]
+    assert main(args) == 0
+    with open(tmp_path / "path.csv") as fh:
+        header = next(csv.reader(fh))
+    assert header[: len(CONTRACT_COLUMNS)] == CONTRACT_COLUMNS
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert CONTRACT_KEYS <= set(summary) and summary["solver"] == "implicit-euler" and summary["converged"]

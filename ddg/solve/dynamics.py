@@ -8,7 +8,7 @@ Here one step from (q_k, v_k) to t_{k+1} = t_k + dt minimises the incremental po
 
 over the free DOFs, with the clamped DOFs prescribed at their t_{k+1} values. Its stationarity
 condition times dt^2 is Eq. (7a) with F_ext = -c M v_{k+1} (mass-proportional viscous damping
-at rate c), its Hessian dt^2 (...) is the Jacobian of Eq. (9), and v_{k+1} = (q_{k+1} - q_k)/dt
+at rate c), its Hessian times dt^2 is the Jacobian of Eq. (9), and v_{k+1} = (q_{k+1} - q_k)/dt
 is Eq. (7c). `IncrementalPotential` wraps a model with these terms, so the ordinary Newton
 solver (ddg.solve.newton) performs each step; the twist angles are measured from reference
 frames parallel-transported in time (the model's commit), as in the paper.
@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..api import SimulationResult, versions
+from ..api import SimulationResult, base_summary
 from ..geometry.strip import InputError, LoadingProtocol, Strip
 from ..observables import observe
 from .banded import SymmetricBanded
@@ -45,21 +45,28 @@ class DynamicOptions:
     time_step (s): largest step, 0.01 s. At 1 mm/s the clamp moves 10 um per step, under 1 %
     of the rod spacing h = L/(M-2) (1.5 mm for the paper's L = 0.15 m at M = 100). The step is
     shortened so that every recorded load is reached exactly (an integer number of equal steps
-    per recorded interval). Implicit Euler is unconditionally stable; with the buckled strips'
-    lowest frequencies omega ~ 200-600 rad/s (the paper's scenes, measured from K v = omega^2 M v),
-    omega dt >> 1, so it dissipates the elastic vibrations within a step or two: as in the paper
-    the scheme is a device for following quasi-static equilibria, not for resolving vibrations.
+    per recorded interval). Implicit Euler is unconditionally stable; the buckled strip's lowest
+    frequencies are omega ~ 180-520 rad/s away from the thresholds (K v = omega^2 M v measured for
+    W/L = 1/20, dL/L = 1/2, M = 100, over the whole shear path), so omega dt > 1 and the scheme
+    dissipates elastic vibrations within a few steps: as in the paper it is a device for
+    following quasi-static equilibria, not for resolving vibrations (use dt << 1/omega for that).
 
     damping (1/s): rate c of the viscous force -c M v, 20 1/s. Two conditions make the response
-    quasi-static at 1 mm/s and this value meets both by orders of magnitude: (i) disturbances
-    (the start of each stage, a snap past a bifurcation) must die out well before the next
-    recorded load; the amplitude of a slow, lightly damped mode decays as exp(-c t / 2), a
+    quasi-static at 1 mm/s, and away from the thresholds this value meets both by orders of
+    magnitude: (i) disturbances (the start of each stage, a snap past a bifurcation) must die
+    out well before the next recorded load; the amplitude of a slow, lightly damped mode decays as exp(-c t / 2), a
     time constant of 0.1 s = 0.1 mm of clamp travel, against ~1-2 mm between recorded loads;
     (ii) on a load ramp a mode of frequency omega trails its equilibrium by c v / omega^2 (for
     implicit Euler exactly as in the continuous equation, since inertia vanishes on a ramp):
-    with omega >= 200 rad/s this is <= 5e-7 m, ~3e-6 L, far below the spatial discretisation
-    error. Near a bifurcation omega -> 0 and any damping lags (critical slowing down); there
-    the dynamic and static paths differ by construction.
+    with omega >= 180 rad/s this is <= 6e-7 m, ~4e-6 L, far below the spatial discretisation
+    error. Near a threshold omega -> 0 and the lag grows (critical slowing down); there the
+    dynamic and static paths differ by construction (measured: up to ~6e-4 L in H_mid/L at
+    the US -> S transition, M = 100, 1 mm/s). That lag is proportional to c (measured at M = 30,
+    3 mm/s: max |dH_mid|/L = 3.7e-6, 2.4e-5, 8.5e-5, 3.2e-4 for c = 0, 5, 20, 80 1/s). c = 0 also
+    works at dt = 0.01 s, because implicit Euler then dissipates through its own numerical
+    damping (rate ~ omega^2 dt / 2 for omega dt < 1), but that depends on dt; c = 20 1/s keeps
+    the decay of slow modes independent of dt, at a cost of ~1e-4 L at the thresholds (median
+    over the path 3e-8 L) in that measurement.
 
     record_interval (s): None records at the static solver's loads (protocol.compression_steps
     and protocol.shear_steps equally spaced targets per stage); a number records every
@@ -150,12 +157,16 @@ class IncrementalPotential:
         return dataclasses.replace(ev, **changes)
 
 
-class _StepFailure(RuntimeError):
-    pass
+class StepFailure(RuntimeError):
+    """A step failed even at the smallest allowed time step (args[0])."""
 
 
-class _Integrator:
-    """State (q, v, t) of the march and the stepping with halving on Newton failure."""
+class ImplicitEuler:
+    """State (q, v, t) of the march: `step` takes one implicit-Euler step to a given clamp load,
+    `advance` marches at constant clamp velocity to a load, halving the step on a Newton failure.
+
+    The model's committed frames must be those of q (call model.commit(q) before).
+    """
 
     def __init__(self, model, options: DynamicOptions, q: np.ndarray, load: tuple[float, float]):
         self.model = model
@@ -205,7 +216,7 @@ class _Integrator:
             it = self.step(s_next - s, load)
             if it is None:
                 if dt / 2.0 < smallest * (1.0 - 1e-12):
-                    raise _StepFailure(dt)
+                    raise StepFailure(dt)
                 dt /= 2.0
                 continue
             iterations += it
@@ -265,29 +276,9 @@ def simulate_dynamic(
     compressions = _targets(dL, protocol.compression_steps, dL / v, options.record_interval)
     shears = _targets(dW, protocol.shear_steps, abs(dW) / v, options.record_interval)
 
-    summary = {
-        "model": "rod",
-        "solver": "implicit-euler",
-        "scene": {
-            **strip.as_dict(),
-            **protocol.as_dict(strip),
-            "resolution": resolution,
-            "clamp_convention": "clamped edges straddle the clamp points; free length exactly L",
-            "dynamics": dataclasses.asdict(options),
-        },
-        "H_mid_over_L_compressed": None,
-        "dW_max_over_L": strip.shear_limit(dL) / L,
-        "dW1_over_L": None,
-        "dW2_over_L": None,
-        "n_dof": model.n_dof,
-        "n_free_dof": int(np.arange(model.n_dof)[model.free].size),
-        "newton_iterations": 0,
-        "wall_time_s": None,
-        "converged": False,
-        "message": "",
-        "lambda_min_normalisation": "lowest eigenvalue of K v = lambda D v (lumped metric D), times L^4 / EI2",
-        "versions": versions(),
-    }
+    summary = base_summary("rod", strip, protocol, resolution, model)
+    summary["solver"] = "implicit-euler"
+    summary["scene"]["dynamics"] = dataclasses.asdict(options)
     rows: list[dict] = []
     trace: list[dict] = []
     t0 = time.perf_counter()
@@ -319,7 +310,7 @@ def simulate_dynamic(
             q0 = model.apply_clamps(model.buckled_guess(first), first, 0.0)
             c0 = first
         model.commit(q0)
-        integrator = _Integrator(model, options, q0, (c0, 0.0))
+        integrator = ImplicitEuler(model, options, q0, (c0, 0.0))
         integrator.t = c0 / v
         integrator.newton_iterations = start_iterations
         pending = start_iterations
@@ -329,12 +320,12 @@ def simulate_dynamic(
             state = record("compression", integrator.q, integrator.load, pending, integrator.kinetic_energy(), integrator.t)
             pending = 0
         summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
-        for target in shears:
+        for target in shears if dW != 0.0 else ():  # as ddg.simulate: no shear rows when dW = 0
             pending = integrator.advance((dL, float(target)), abs(float(target) - integrator.load[1]) / v)
             state = record("shear", integrator.q, integrator.load, pending, integrator.kinetic_energy(), integrator.t)
         summary["converged"] = True
         summary["message"] = "path complete"
-    except _StepFailure as exc:
+    except StepFailure as exc:
         c, s = integrator.load
         summary["message"] = (
             f"implicit Euler failed to converge beyond dL/L = {c / L:.6g}, dW/L = {s / L:.6g} "

@@ -1,11 +1,10 @@
 """Python API: ddg.simulate(strip, protocol, model="rod") mirrors `python -m ddg simulate`."""
 from __future__ import annotations
 
-import math
 import platform
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np

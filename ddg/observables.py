@@ -7,7 +7,6 @@ lambda_min: lowest normalised eigenvalue of the free-DOF Hessian (see the model)
 """
 from __future__ import annotations
 
-import numpy as np
 
 from .solve.stability import lowest_modes
 

@@ -1,5 +1,4 @@
 """The rod against exact solutions and the paper: elastica, Euler load, symmetry, thresholds."""
-import math
 
 import numpy as np
 import pytest

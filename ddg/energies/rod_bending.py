@@ -6,7 +6,6 @@ undeformed Voronoi length.
 """
 from __future__ import annotations
 
-import numpy as np
 
 from .rod_curvature import StencilGeometry, curvature_derivatives
 

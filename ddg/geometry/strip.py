@@ -8,7 +8,7 @@ moved toward the other by dL along x (compression), then translated by dW along 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 #: Paper defaults (section 2): clamps 75 mm apart after compression, shim stock b = 0.127 mm.
 CLAMP_SPAN_AFTER_COMPRESSION = 75e-3

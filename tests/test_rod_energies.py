@@ -379,38 +379,23 @@ def _planar_arc(model: RodModel, turning: float, plane_axis: int) -> np.ndarray:
 
 
 @pytest.mark.parametrize("nodes", RESOLUTIONS)
-def test_out_of_plane_bending_costs_EI2(nodes):
-    """Bending towards the normal m1 (in the x-z plane): only kappa_n = 2 tan(phi/2),
-    energy sum EI2 kappa_n^2 / (2 dl); no geodesic curvature, no twist, no stretch."""
+@pytest.mark.parametrize("plane_axis, stiffness_name", [(2, "bending_stiffness"), (1, "geodesic_bending_stiffness")])
+def test_planar_arc_costs_its_bending_stiffness(nodes, plane_axis, stiffness_name):
+    """An arc bent towards the normal m1 (x-z plane) has only kappa_n and costs EI2; an arc bent in
+    the plane of the strip (x-y plane) has only kappa_g and costs EI1 = E b W^3 / 12. Energy
+    sum EI kappa^2 / (2 dl) with kappa = 2 tan(phi/2); no twist, no stretch."""
     model = RodModel(STRIP, nodes)
     turning = 1.6 / (nodes - 2)
-    q = _planar_arc(model, turning, plane_axis=2)
+    q = _planar_arc(model, turning, plane_axis=plane_axis)
     g, m_ref = stencil_geometry(model, q)
     kappa_n, kappa_g = material_curvatures(g)
-    assert np.allclose(np.abs(kappa_n), 2 * np.tan(turning / 2), rtol=1e-12)
-    assert np.max(np.abs(kappa_g)) < 1e-12 * np.max(np.abs(kappa_n))
+    bent, unbent = (kappa_n, kappa_g) if plane_axis == 2 else (kappa_g, kappa_n)
+    assert np.allclose(np.abs(bent), 2 * np.tan(turning / 2), rtol=1e-12)
+    assert np.max(np.abs(unbent)) < 1e-12 * np.max(np.abs(bent))
     assert np.max(np.abs(m_ref)) < 1e-13
     ev = model.evaluate(q)
-    expected = (nodes - 2) * STRIP.bending_stiffness / (2 * model.centerline.spacing) * (2 * np.tan(turning / 2)) ** 2
-    assert ev.parts["bending"] == pytest.approx(expected, rel=1e-12)
-    assert ev.parts["twisting"] < 1e-24 * expected
-    assert ev.parts["stretching"] < 1e-20 * expected
-
-
-@pytest.mark.parametrize("nodes", RESOLUTIONS)
-def test_in_plane_bending_costs_EI1(nodes):
-    """Bending in the plane of the strip (x-y plane): only kappa_g, stiffness EI1 = E b W^3 / 12."""
-    model = RodModel(STRIP, nodes)
-    turning = 1.6 / (nodes - 2)
-    q = _planar_arc(model, turning, plane_axis=1)
-    g, m_ref = stencil_geometry(model, q)
-    kappa_n, kappa_g = material_curvatures(g)
-    assert np.allclose(np.abs(kappa_g), 2 * np.tan(turning / 2), rtol=1e-12)
-    assert np.max(np.abs(kappa_n)) < 1e-12 * np.max(np.abs(kappa_g))
-    assert np.max(np.abs(m_ref)) < 1e-13
-    ev = model.evaluate(q)
-    expected = ((nodes - 2) * STRIP.geodesic_bending_stiffness / (2 * model.centerline.spacing)
-                * (2 * np.tan(turning / 2)) ** 2)
+    stiffness = getattr(STRIP, stiffness_name)
+    expected = (nodes - 2) * stiffness / (2 * model.centerline.spacing) * (2 * np.tan(turning / 2)) ** 2
     assert ev.parts["bending"] == pytest.approx(expected, rel=1e-12)
     assert ev.parts["twisting"] < 1e-24 * expected
     assert ev.parts["stretching"] < 1e-20 * expected

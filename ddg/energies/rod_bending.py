@@ -30,8 +30,6 @@ def bending_energy(g: StencilGeometry, voronoi_lengths, bending_stiffness, geode
     return energy, grad, hess
 
 
-def curvature_hessian_terms(hn, hg, weight_n, weight_g, extra=()):
-    """sum of weight * Hessian(kappa) terms (plus `extra` (StencilHessian, weight) pairs), mapped to 11x11."""
-    others = [hg] + [h for h, _ in extra]
-    weights = [weight_n, weight_g] + [w for _, w in extra]
-    return hn.scaled_sum(weights, others).to_stencil()
+def curvature_hessian_terms(hn, hg, weight_n, weight_g):
+    """weight_n Hess(kappa_n) + weight_g Hess(kappa_g), mapped to the 11x11 stencil."""
+    return hn.scaled_sum([weight_n, weight_g], [hg]).to_stencil()

@@ -1,0 +1,126 @@
+"""Hinge bending of a triangle mesh, Eq. (11b): E = sum over bending pairs c_h |n_a - n_b|^2.
+
+n_a, n_b are the unit normals of the two triangles sharing the hinge edge, each computed from
+its counter-clockwise vertices (p0, p1, p2) as n = u / |u|, u = (p1 - p0) x (p2 - p0), so a flat
+mesh has all normals +z and zero energy. |n_a - n_b|^2 = 2 (1 - n_a . n_b) = 4 sin^2(theta/2)
+with theta the dihedral (bending) angle.
+
+Continuum limit (derived in the docstring of `hinge_stiffness`; tested): on an equilateral
+mesh a constant c gives an isotropic bending energy density D_eff/2 (2H)^2 - D_eff K_G with
+D_eff = 2 c / sqrt(3) (a plate with bending Poisson ratio 0). The paper's c = E b^3 / (12
+sqrt(3)) therefore gives D_eff = (2/3) E b^3 / 12.
+
+Derivatives. With e_i = p_{i+1} - p_{i+2} the edge opposite vertex i and [e]x the cross-product
+matrix, du/dp_i = -[e_i]x and dn/du = P / |u|, P = I - n n^T. Writing S = [[e_0]x; [e_1]x;
+[e_2]x] (9 x 3), the Jacobian of the normal is J = (P / |u|) S^T (3 x 9). Since
+E = sum_h 2 c_h (1 - n_a . n_b), every triangle sees m_a = sum over its hinges of c_h n_b:
+
+  grad_a E = -2 J_a^T m_a,
+  hess E   = -2 [ per triangle: S Hu S^T + B(g)   ;   per hinge: c_h (J_a^T J_b + J_b^T J_a) ],
+
+with Hu = -[ (P m) n^T + n (P m)^T + (m . n) P ] / |u|^2 the Hessian of m . u/|u| in u,
+g = P m / |u| its gradient, and B(g) the 9 x 9 block matrix from the bilinearity of u in the
+vertices: blocks (i, i+1) = -[g]x and (i+1, i) = +[g]x (indices mod 3).
+The triangle terms cost O(T) and the hinge terms O(H); no per-hinge 12 x 12 second
+derivatives of normals are formed.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: Local positions of triangle a = (v0, v1, a) and triangle b = (v1, v0, b) in a hinge (v0, v1, a, b).
+HINGE_SLOTS_A = np.array([0, 1, 2])
+HINGE_SLOTS_B = np.array([1, 0, 3])
+
+
+def cross_matrix(v: np.ndarray) -> np.ndarray:
+    """[v]x for a stack of vectors (..., 3) -> (..., 3, 3), with [v]x w = v x w."""
+    m = np.zeros(v.shape[:-1] + (3, 3))
+    m[..., 0, 1], m[..., 0, 2] = -v[..., 2], v[..., 1]
+    m[..., 1, 0], m[..., 1, 2] = v[..., 2], -v[..., 0]
+    m[..., 2, 0], m[..., 2, 1] = -v[..., 1], v[..., 0]
+    return m
+
+
+def triangle_normals(x: np.ndarray, triangles: np.ndarray):
+    """Unit normals (T, 3) and doubled areas |u| (T,) of the deformed triangles."""
+    p = x[triangles]
+    u = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    double_area = np.linalg.norm(u, axis=1)
+    return u / double_area[:, None], double_area
+
+
+def hinge_stiffness(rest_edge_lengths: np.ndarray, rest_pair_areas: np.ndarray, bending_stiffness: float) -> np.ndarray:
+    """Per-hinge coefficient c_h that gives the continuum plate bending stiffness D.
+
+    Derivation (equilateral mesh, side l): rolling onto a cylinder of curvature k, a hinge
+    whose edge normal makes the angle phi with the bending direction has theta = k l cos(phi)
+    / sqrt(3) (centroids l / sqrt(3) apart). There are 2 sqrt(3) / (3 l^2) hinges per unit area
+    in each of three directions 60 degrees apart and sum cos^2 = 3/2, so the energy density is
+    c k^2 / sqrt(3) = D_eff k^2 / 2: D_eff = 2 c / sqrt(3) for any bending direction. On a
+    sphere every hinge bends by k l / sqrt(3), giving twice the cylinder's density: the
+    Gaussian-curvature modulus is -D_eff (bending Poisson ratio 0).
+
+    For general meshes the constant is spread with the discrete-shells weight
+    |e|^2 / (A_a + A_b), which equals 2 / sqrt(3) on equilateral triangles:
+    c_h = (3/4) D |e_bar|^2 / (A_a + A_b)  (= sqrt(3)/2 D on an equilateral mesh).
+    """
+    return 0.75 * bending_stiffness * rest_edge_lengths**2 / rest_pair_areas
+
+
+def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: np.ndarray,
+                         hinge_edge_slots: np.ndarray, stiffness: np.ndarray, *, gradient: bool = True,
+                         hessian: bool = True):
+    """Eq. (11b) for the deformed node positions x (N, 3).
+
+    hinge_edge_slots (H, 2): the local edge index k (edge from vertex k to k+1) of the shared
+    edge in triangle a and in triangle b (PlateMesh.hinge_edge_slots).
+
+    Returns (energy per hinge (H,), gradient per triangle (T, 9), Hessian per triangle
+    (T, 9, 9), Hessian per hinge (H, 12, 12)) -- the gradient and triangle blocks in the
+    triangles' vertex order, the hinge blocks in hinge order (v0, v1, a, b). Unrequested parts
+    are None. Assembly sums the blocks (ddg.models.plate).
+    """
+    n, double_area = triangle_normals(x, triangles)
+    tri_a, tri_b = hinge_triangles[:, 0], hinge_triangles[:, 1]
+    diff = n[tri_a] - n[tri_b]
+    energy = stiffness * np.einsum("hi,hi->h", diff, diff)
+    if not gradient:
+        return energy, None, None, None
+    count = len(triangles)
+    m = np.stack([np.bincount(tri_a, weights=stiffness * n[tri_b, k], minlength=count)
+                  + np.bincount(tri_b, weights=stiffness * n[tri_a, k], minlength=count) for k in range(3)], axis=1)
+    p = x[triangles]
+    opposite = np.stack([p[:, 1] - p[:, 2], p[:, 2] - p[:, 0], p[:, 0] - p[:, 1]], axis=1)  # e_i, (T, 3, 3)
+    S = cross_matrix(opposite).reshape(count, 9, 3)
+    projector = np.eye(3) - n[:, :, None] * n[:, None, :]
+    pm = np.einsum("tij,tj->ti", projector, m)
+    g_u = pm / double_area[:, None]
+    grad = -2.0 * np.einsum("tai,ti->ta", S, g_u)
+    if not hessian:
+        return energy, grad, None, None
+    mn = np.einsum("ti,ti->t", m, n)
+    h_u = -(pm[:, :, None] * n[:, None, :] + n[:, :, None] * pm[:, None, :] + mn[:, None, None] * projector)
+    h_u /= (double_area**2)[:, None, None]
+    hess_tri = np.einsum("tai,tij,tbj->tab", S, h_u, S)
+    G = cross_matrix(g_u)
+    for i in range(3):
+        j = (i + 1) % 3
+        hess_tri[:, 3 * i:3 * i + 3, 3 * j:3 * j + 3] -= G
+        hess_tri[:, 3 * j:3 * j + 3, 3 * i:3 * i + 3] += G
+    hess_tri *= -2.0
+
+    J = np.einsum("tij,taj->tia", projector / double_area[:, None, None], S).reshape(count, 3, 3, 3).transpose(0, 2, 1, 3)
+    # columns of J_a in hinge order (v0, v1, a): vertex positions k_a, k_a + 1, k_a + 2 of triangle a
+    hinge_count = len(stiffness)
+    positions = (hinge_edge_slots[:, :1] + np.arange(3)[None, :]) % 3
+    J_a = J[tri_a[:, None], positions]  # (H, 3 vertices, 3 normal comps, 3 coords)
+    positions = (hinge_edge_slots[:, 1:] + np.arange(3)[None, :]) % 3
+    J_b = J[tri_b[:, None], positions]  # vertex order (v1, v0, b)
+    cross = -2.0 * stiffness[:, None, None, None, None] * np.einsum("hpic,hqid->hpcqd", J_a, J_b)
+    hess_hinge = np.zeros((hinge_count, 4, 3, 4, 3))
+    for ia, sa in enumerate(HINGE_SLOTS_A):
+        for ib, sb in enumerate(HINGE_SLOTS_B):
+            hess_hinge[:, sa, :, sb, :] += cross[:, ia, :, ib, :]
+            hess_hinge[:, sb, :, sa, :] += cross[:, ia, :, ib, :].transpose(0, 2, 1)
+    return energy, grad, hess_tri, hess_hinge.reshape(-1, 12, 12)

@@ -15,13 +15,14 @@ from .io import write_path_csv, write_summary_json
 from .observables import observe
 from .solve.continuation import ContinuationFailure, ContinuationOptions, PathFollower
 
-DEFAULT_RESOLUTION = {"rod": 100}
+DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000}
 
 
 def _model_class(name: str):
+    from .models.plate import PlateModel
     from .models.rod import RodModel
 
-    models = {"rod": RodModel}
+    models = {"rod": RodModel, "plate": PlateModel}
     if name not in models:
         raise InputError(f"model = {name!r} is not available; choose one of {sorted(models)}")
     return models[name]

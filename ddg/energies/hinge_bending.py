@@ -5,10 +5,14 @@ its counter-clockwise vertices (p0, p1, p2) as n = u / |u|, u = (p1 - p0) x (p2 
 mesh has all normals +z and zero energy. |n_a - n_b|^2 = 2 (1 - n_a . n_b) = 4 sin^2(theta/2)
 with theta the dihedral (bending) angle.
 
-Continuum limit (derived in the docstring of `hinge_stiffness`; tested): on an equilateral
-mesh a constant c gives an isotropic bending energy density D_eff/2 (2H)^2 - D_eff K_G with
-D_eff = 2 c / sqrt(3) (a plate with bending Poisson ratio 0). The paper's c = E b^3 / (12
-sqrt(3)) therefore gives D_eff = (2/3) E b^3 / 12.
+Continuum limit (Seung and Nelson 1988; measured in tests/test_plate_energies.py): on an
+equilateral mesh a constant c gives an isotropic bending energy density D_eff/2 (2H)^2 with
+D_eff = sqrt(3) c, for any bending direction. So the paper's c = E b^3 / (12 sqrt(3)) gives
+exactly D_eff = E b^3 / 12, the plate bending stiffness with Poisson ratio 0 (the rod's EI2 / W).
+(A tempting shortcut, taking each triangle's normal as the surface normal at its centroid,
+gives 2 c / sqrt(3) and is wrong: a triangle inscribed in a cylinder has the normal of its
+chord: on a lattice with edges along the cylinder axis, the angle across those edges is 3/2
+times larger and across the others it vanishes; the energy is 3/2 the shortcut's.)
 
 Derivatives. With e_i = p_{i+1} - p_{i+2} the edge opposite vertex i and [e]x the cross-product
 matrix, du/dp_i = -[e_i]x and dn/du = P / |u|, P = I - n n^T. Writing S = [[e_0]x; [e_1]x;
@@ -51,21 +55,13 @@ def triangle_normals(x: np.ndarray, triangles: np.ndarray):
 
 
 def hinge_stiffness(rest_edge_lengths: np.ndarray, rest_pair_areas: np.ndarray, bending_stiffness: float) -> np.ndarray:
-    """Per-hinge coefficient c_h that gives the continuum plate bending stiffness D.
+    """Per-hinge coefficient c_h giving the continuum plate bending stiffness D.
 
-    Derivation (equilateral mesh, side l): rolling onto a cylinder of curvature k, a hinge
-    whose edge normal makes the angle phi with the bending direction has theta = k l cos(phi)
-    / sqrt(3) (centroids l / sqrt(3) apart). There are 2 sqrt(3) / (3 l^2) hinges per unit area
-    in each of three directions 60 degrees apart and sum cos^2 = 3/2, so the energy density is
-    c k^2 / sqrt(3) = D_eff k^2 / 2: D_eff = 2 c / sqrt(3) for any bending direction. On a
-    sphere every hinge bends by k l / sqrt(3), giving twice the cylinder's density: the
-    Gaussian-curvature modulus is -D_eff (bending Poisson ratio 0).
-
-    For general meshes the constant is spread with the discrete-shells weight
-    |e|^2 / (A_a + A_b), which equals 2 / sqrt(3) on equilateral triangles:
-    c_h = (3/4) D |e_bar|^2 / (A_a + A_b)  (= sqrt(3)/2 D on an equilateral mesh).
+    On equilateral triangles c = D / sqrt(3) (Eq. 11b with D = E b^3 / 12, D_eff = sqrt(3) c).
+    For general meshes it is spread with the discrete-shells weight |e|^2 / (A_a + A_b), which
+    is 2 / sqrt(3) on equilateral triangles: c_h = D |e_bar|^2 / (2 (A_a + A_b)).
     """
-    return 0.75 * bending_stiffness * rest_edge_lengths**2 / rest_pair_areas
+    return 0.5 * bending_stiffness * rest_edge_lengths**2 / rest_pair_areas
 
 
 def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: np.ndarray,
@@ -77,9 +73,11 @@ def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: 
     edge in triangle a and in triangle b (PlateMesh.hinge_edge_slots).
 
     Returns (energy per hinge (H,), gradient per triangle (T, 9), Hessian per triangle
-    (T, 9, 9), Hessian per hinge (H, 12, 12)) -- the gradient and triangle blocks in the
-    triangles' vertex order, the hinge blocks in hinge order (v0, v1, a, b). Unrequested parts
-    are None. Assembly sums the blocks (ddg.models.plate).
+    (T, 9, 9), cross blocks per hinge (H, 9, 9)) -- the gradient and triangle blocks in the
+    triangles' vertex order; the cross block C couples triangle a's vertices (v0, v1, a) (rows)
+    with triangle b's (v1, v0, b) (columns) and enters the Hessian as C + C^T
+    (`expand_hinge_blocks` gives the (H, 12, 12) form). Unrequested parts are None. Assembly
+    sums the blocks (ddg.models.plate).
     """
     n, double_area = triangle_normals(x, triangles)
     tri_a, tri_b = hinge_triangles[:, 0], hinge_triangles[:, 1]
@@ -96,31 +94,40 @@ def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: 
     projector = np.eye(3) - n[:, :, None] * n[:, None, :]
     pm = np.einsum("tij,tj->ti", projector, m)
     g_u = pm / double_area[:, None]
-    grad = -2.0 * np.einsum("tai,ti->ta", S, g_u)
+    grad = -2.0 * (S @ g_u[:, :, None])[:, :, 0]
     if not hessian:
         return energy, grad, None, None
     mn = np.einsum("ti,ti->t", m, n)
     h_u = -(pm[:, :, None] * n[:, None, :] + n[:, :, None] * pm[:, None, :] + mn[:, None, None] * projector)
     h_u /= (double_area**2)[:, None, None]
-    hess_tri = np.einsum("tai,tij,tbj->tab", S, h_u, S)
+    St = S.transpose(0, 2, 1)
+    hess_tri = S @ h_u @ St
     G = cross_matrix(g_u)
+    view = hess_tri.reshape(count, 3, 3, 3, 3)  # (vertex i, coord, vertex j, coord)
     for i in range(3):
         j = (i + 1) % 3
-        hess_tri[:, 3 * i:3 * i + 3, 3 * j:3 * j + 3] -= G
-        hess_tri[:, 3 * j:3 * j + 3, 3 * i:3 * i + 3] += G
+        view[:, i, :, j, :] -= G
+        view[:, j, :, i, :] += G
     hess_tri *= -2.0
 
-    J = np.einsum("tij,taj->tia", projector / double_area[:, None, None], S).reshape(count, 3, 3, 3).transpose(0, 2, 1, 3)
-    # columns of J_a in hinge order (v0, v1, a): vertex positions k_a, k_a + 1, k_a + 2 of triangle a
-    hinge_count = len(stiffness)
-    positions = (hinge_edge_slots[:, :1] + np.arange(3)[None, :]) % 3
-    J_a = J[tri_a[:, None], positions]  # (H, 3 vertices, 3 normal comps, 3 coords)
-    positions = (hinge_edge_slots[:, 1:] + np.arange(3)[None, :]) % 3
-    J_b = J[tri_b[:, None], positions]  # vertex order (v1, v0, b)
-    cross = -2.0 * stiffness[:, None, None, None, None] * np.einsum("hpic,hqid->hpcqd", J_a, J_b)
-    hess_hinge = np.zeros((hinge_count, 4, 3, 4, 3))
-    for ia, sa in enumerate(HINGE_SLOTS_A):
-        for ib, sb in enumerate(HINGE_SLOTS_B):
-            hess_hinge[:, sa, :, sb, :] += cross[:, ia, :, ib, :]
-            hess_hinge[:, sb, :, sa, :] += cross[:, ia, :, ib, :].transpose(0, 2, 1)
-    return energy, grad, hess_tri, hess_hinge.reshape(-1, 12, 12)
+    J = (projector / double_area[:, None, None]) @ St  # (T, 3 normal components, 9)
+    # columns of J_a in hinge order (v0, v1, a): vertices k_a, k_a + 1, k_a + 2 of triangle a;
+    # of J_b in the order (v1, v0, b): vertices k_b, k_b + 1, k_b + 2 of triangle b
+    coords = np.arange(3)[None, None, :]
+    columns_a = (3 * ((hinge_edge_slots[:, :1] + np.arange(3)) % 3)[:, :, None] + coords).reshape(-1, 1, 9)
+    columns_b = (3 * ((hinge_edge_slots[:, 1:] + np.arange(3)) % 3)[:, :, None] + coords).reshape(-1, 1, 9)
+    J_a = np.take_along_axis(J[tri_a], columns_a, axis=2)
+    J_b = np.take_along_axis(J[tri_b], columns_b, axis=2)
+    cross = (-2.0 * stiffness)[:, None, None] * (J_a.transpose(0, 2, 1) @ J_b)  # rows (v0, v1, a), cols (v1, v0, b)
+    return energy, grad, hess_tri, cross
+
+
+def expand_hinge_blocks(cross: np.ndarray) -> np.ndarray:
+    """The symmetric (H, 12, 12) hinge blocks C + C^T in hinge order (v0, v1, a, b) from the
+    cross blocks C (rows: triangle a's (v0, v1, a), columns: triangle b's (v1, v0, b))."""
+    rows_a = (3 * HINGE_SLOTS_A[:, None] + np.arange(3)).ravel()
+    cols_b = (3 * HINGE_SLOTS_B[:, None] + np.arange(3)).ravel()
+    blocks = np.zeros((len(cross), 12, 12))
+    blocks[:, rows_a[:, None], cols_b[None, :]] = cross
+    blocks[:, cols_b[:, None], rows_a[None, :]] += cross.transpose(0, 2, 1)
+    return blocks

@@ -61,3 +61,26 @@ class Centerline:
         j = int(np.clip(np.searchsorted(sn, s) - 1, 0, self.nodes - 2))
         w = (s - sn[j]) / self.spacing
         return (1.0 - w) * values[j] + w * values[j + 1]
+
+
+def first_mode_profile(length: float, compression: float, s: np.ndarray, direction: int = 1, samples: int = 4001):
+    """Inextensible first-mode shape with chord L - dL: (x(s), z(s)) at rest arclengths s in [0, L].
+
+    Tangent angle phi(s) = phi0 sin(2 pi s / L); the chord is L J0(phi0), so phi0 solves
+    J0(phi0) = 1 - dL / L. Used as the plate's starting guess for compression (the rod uses the
+    discrete version of the same shape, RodModel.buckled_guess).
+    """
+    from scipy.optimize import brentq
+    from scipy.special import j0
+
+    ratio = compression / length
+    if not 0.0 <= ratio < 1.0:
+        raise InputError(f"compression dL/L = {ratio:g} outside the allowed range [0, 1)")
+    phi0 = brentq(lambda p: j0(p) - (1.0 - ratio), 0.0, 2.404825557695773) if ratio > 0 else 0.0
+    grid = np.linspace(0.0, length, samples)
+    phi = direction * phi0 * np.sin(2.0 * np.pi * grid / length)
+    step = grid[1] - grid[0]
+    x = np.r_[0.0, np.cumsum(0.5 * step * (np.cos(phi[1:]) + np.cos(phi[:-1])))]
+    z = np.r_[0.0, np.cumsum(0.5 * step * (np.sin(phi[1:]) + np.sin(phi[:-1])))]
+    s = np.asarray(s, dtype=float)
+    return np.interp(s, grid, x), np.interp(s, grid, z)

@@ -9,8 +9,6 @@ starts with m1 = +z (the strip normal), t = +x, m2 = t x m1 = -y.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from scipy.optimize import brentq
 
@@ -21,21 +19,15 @@ from ..energies.stretch import stretching_energy, two_node_blocks
 from ..geometry.centerline import Centerline
 from ..geometry.frames import material_frame, parallel_transport, reference_twist
 from ..geometry.strip import Strip
-from ..solve.banded import BandAssembler, SymmetricBanded
+from ..solve.banded import BandAssembler
+from .base import BandedModel, Evaluation
+
+__all__ = ["RodModel", "Evaluation"]
 
 CLAMPED_DOFS_PER_END = 7
 
 
-@dataclass
-class Evaluation:
-    energy: float
-    gradient: np.ndarray | None = None
-    hessian: SymmetricBanded | None = None
-    parts: dict | None = None
-    frames: tuple | None = None  # (tangents, d1, m_ref) of the evaluated state
-
-
-class RodModel:
+class RodModel(BandedModel):
     """The DAR of a Strip on a Centerline of M nodes, with its reference-frame state."""
 
     name = "rod"
@@ -113,11 +105,6 @@ class RodModel:
         values[right] += shift
         return values
 
-    def apply_clamps(self, q: np.ndarray, compression: float, shear: float) -> np.ndarray:
-        q = q.copy()
-        q[self.constrained] = self.clamp_values(compression, shear)
-        return q
-
     def midpoint(self, q: np.ndarray) -> np.ndarray:
         """Centerline point at rest arclength s = L/2 (linear along the edge, O(h^2))."""
         return self.centerline.interpolate_at(q[self.node_dofs], 0.5 * self.strip.length)
@@ -192,20 +179,6 @@ class RodModel:
         return e_b, e_t, g_b, g_t, hess
 
     # ------------------------------------------------------------------ linear algebra
-    def free_matrix(self, hessian: SymmetricBanded) -> SymmetricBanded:
-        """Hessian restricted to the free DOFs (a contiguous block of the band), cached on it."""
-        block = getattr(hessian, "_free_block", None)
-        if block is None:
-            block = hessian.restrict(self.free.start, self.free.stop)
-            hessian._free_block = block
-        return block
-
-    def coupling(self, hessian: SymmetricBanded, dq_constrained: np.ndarray) -> np.ndarray:
-        """H_fc dq_c: the force change on the free DOFs from moving the clamps by dq_c."""
-        dq = np.zeros(self.n_dof)
-        dq[self.constrained] = dq_constrained
-        return hessian.matvec(dq)[self.free]
-
     def eigenvalue_metric(self) -> tuple[np.ndarray, float]:
         """Lumped metric D of the free DOFs and the unit of the normalised eigenvalue.
 

@@ -1,8 +1,11 @@
-"""Symmetric banded matrices (lower storage) for the rod: assembly, Cholesky, eigenvalues.
+"""Symmetric banded matrices (lower storage): assembly, Cholesky, solves, eigenvalues.
 
 Storage follows LAPACK's lower band form: band[d, j] = A[j + d, j] for 0 <= d <= bandwidth.
 The rod's DOF vector (Eq. 1) interleaves positions and twists so that every element touches
 a contiguous block of at most 11 DOFs: the Hessian has bandwidth 10 and Newton costs O(M).
+The plate orders its nodes along the strip (ddg.geometry.plate_mesh), so its Hessian is
+banded too, with a bandwidth of about six times the nodes per column: for a strip a banded
+Cholesky beats general sparse factorisations (measured in benchmarks/plate_path.py).
 """
 from __future__ import annotations
 
@@ -28,14 +31,43 @@ class BandAssembler:
             raise ValueError("element block wider than the band")
         flat = (a - b)[None, :] * self.n + offsets[:, None] + b[None, :]
         local = a * size + b
-        self._families.append((flat.ravel(), local))
+        self._families.append((flat.ravel(), local, "contiguous"))
+        return len(self._families) - 1
+
+    def add_indexed_family(self, dofs: np.ndarray) -> int:
+        """A family of symmetric (m x m) blocks on arbitrary DOFs dofs (K, m), e.g. a triangle's
+        nine coordinates; only the entries that fall in the lower band are gathered."""
+        rows, cols = dofs[:, :, None], dofs[:, None, :]
+        lower = np.broadcast_to(rows >= cols, (len(dofs),) + (dofs.shape[1],) * 2)
+        if np.any(np.abs(rows - cols) > self.bandwidth):
+            raise ValueError("element block wider than the band")
+        flat = ((rows - cols) * self.n + cols)[lower]
+        self._families.append((flat, np.flatnonzero(lower.ravel()), "indexed"))
+        return len(self._families) - 1
+
+    def add_pair_family(self, row_dofs: np.ndarray, col_dofs: np.ndarray) -> int:
+        """A family of blocks C (K, m, p) entering the matrix as C + C^T on rows row_dofs (K, m)
+        and columns col_dofs (K, p): each entry lands once in the lower band (twice on the
+        diagonal, where C and C^T coincide)."""
+        rows, cols = row_dofs[:, :, None], col_dofs[:, None, :]
+        if np.any(np.abs(rows - cols) > self.bandwidth):
+            raise ValueError("element block wider than the band")
+        low, high = np.minimum(rows, cols), np.maximum(rows, cols)
+        flat = ((high - low) * self.n + low).ravel()
+        self._families.append((flat, np.where(rows == cols, 2.0, 1.0).ravel(), "pair"))
         return len(self._families) - 1
 
     def assemble(self, blocks: list[np.ndarray]) -> "SymmetricBanded":
         total = np.zeros((self.bandwidth + 1) * self.n)
-        for (flat, local), values in zip(self._families, blocks):
-            m = values.shape[1]
-            total += np.bincount(flat, weights=values.reshape(-1, m * m)[:, local].ravel(), minlength=total.size)
+        for (flat, local, kind), values in zip(self._families, blocks):
+            if kind == "indexed":  # positions in the whole stack of blocks
+                picked = values.ravel()[local]
+            elif kind == "pair":  # local holds the multiplicity (2 on the diagonal)
+                picked = values.ravel() * local
+            else:
+                m = values.shape[1]
+                picked = values.reshape(-1, m * m)[:, local].ravel()
+            total += np.bincount(flat, weights=picked, minlength=total.size)
         return SymmetricBanded(total.reshape(self.bandwidth + 1, self.n))
 
 
@@ -106,41 +138,32 @@ class SymmetricBanded:
         return sla.solve_banded((u, u), full, rhs, check_finite=False)
 
     def lowest_eigenpairs(self, count: int = 1, vectors: bool = False):
-        """The `count` lowest eigenvalues (and eigenvectors).
+        """The `count` lowest eigenvalues (and eigenvectors), by shift-invert Lanczos.
 
-        Positive definite (Cholesky succeeded): Lanczos on the inverse, O(n) per iteration,
-        exact for the lowest eigenvalues because all are positive. Otherwise LAPACK's banded
-        eigensolver for the values (dsbevx: O(n^2) band reduction, used only on unstable
-        states) and inverse iteration for the vectors.
+        Positive definite (Cholesky succeeded): Lanczos on the inverse, O(n b^2) to factor and
+        O(n b) per iteration, exact for the lowest eigenvalues because all are positive.
+        Otherwise the smallest shift sigma (growing by 4x from 1e-8 of the mean diagonal) that
+        makes A + sigma I positive definite brackets the lowest eigenvalue in (-sigma, -sigma/4],
+        and Lanczos on (A + sigma I)^-1 finds it and its neighbours.
         """
         count = min(count, self.n)
-        if self.cholesky() and self.n > 4 * count + 20:
-            from scipy.sparse.linalg import LinearOperator, eigsh
+        if self.n <= 4 * count + 20:
+            w, v = np.linalg.eigh(self.to_dense())
+            return (w[:count], v[:, :count]) if vectors else w[:count]
+        from scipy.sparse.linalg import LinearOperator, eigsh
 
-            inverse = LinearOperator((self.n, self.n), matvec=self.solve, dtype=float)
-            mu, v = eigsh(inverse, k=count, which="LA", tol=1e-12, ncv=min(self.n, max(2 * count + 1, 20)),
-                          v0=np.ones(self.n))
-            order = np.argsort(-mu)
-            w = 1.0 / mu[order]
-            return (w, v[:, order]) if vectors else w
-        w = np.atleast_1d(sla.eig_banded(self.band, lower=True, eigvals_only=True, select="i",
-                                         select_range=(0, count - 1), check_finite=False))
-        if not vectors:
-            return w
-        # eigenvectors by inverse iteration just below each eigenvalue (O(n) per iteration;
-        # asking LAPACK for them forms the full orthogonal transform, O(n^3))
-        vecs = np.empty((self.n, count))
-        scale = max(1.0, float(np.max(np.abs(w))))
-        rng = np.random.default_rng(0)
-        for i, lam in enumerate(w):
-            shifted = self.shifted(-(lam - 1e-10 * scale))
-            v = rng.standard_normal(self.n)
-            for _ in range(4):
-                v = shifted.solve(v)
-                v -= vecs[:, :i] @ (vecs[:, :i].T @ v)
-                v /= np.linalg.norm(v)
-            vecs[:, i] = v
-        return w, vecs
+        shift, operator = 0.0, self
+        if not self.cholesky():
+            shift = 1e-8 * max(self.mean_diagonal(), np.finfo(float).tiny)
+            while not self.shifted(shift).cholesky():
+                shift *= 4.0
+            operator = self.shifted(shift)
+        inverse = LinearOperator((self.n, self.n), matvec=operator.solve, dtype=float)
+        mu, v = eigsh(inverse, k=count, which="LA", tol=1e-12, ncv=min(self.n, max(2 * count + 1, 20)),
+                      v0=np.ones(self.n))
+        order = np.argsort(-mu)
+        w = 1.0 / mu[order] - shift
+        return (w, v[:, order]) if vectors else w
 
     def to_dense(self) -> np.ndarray:
         a = np.diag(self.band[0])

@@ -1,0 +1,199 @@
+"""Discrete Elastic Plate (DEP), paper section 3.2.
+
+DOF vector q = [x_0, x_1, ..., x_{N-1}] (Eq. 10), 3N entries, nodes of a flat triangle mesh
+of the strip (ddg.geometry.plate_mesh). Energy: edge springs (Eq. 11a) and hinge bending from
+neighbouring triangle normals (Eq. 11b).
+
+Stiffnesses (derived in ddg.energies.hinge_bending and tested):
+- stretching: k_e = E b (A_a + A_b) / |e_bar|^2 per edge (sum of the reference areas of the
+  triangles sharing it). On interior edges of an equilateral mesh this is Eq. (11a)'s
+  sqrt(3)/2 E b; the continuum limit is an isotropic membrane of 2D modulus E b and Poisson
+  ratio 1/3 (boundary edges carry half, so the membrane is uniform up to the edge).
+- bending: c_h = D |e_bar|^2 / (2 (A_a + A_b)) per hinge with D = E b^3 / 12: on equilateral
+  triangles exactly Eq. (11b)'s E b^3 / (12 sqrt(3)), whose continuum limit is the plate
+  bending stiffness D (Seung and Nelson 1988; bending Poisson ratio 0, as the rod with nu = 0:
+  twisting a strip costs GJ = 2 D W).
+
+Clamps (section 4): every node with x <= 0 (two columns on the structured mesh) moves with
+the fixed clamp and every node with x >= L with the moving one; the free plate is exactly L.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..energies.hinge_bending import HINGE_SLOTS_A, HINGE_SLOTS_B, hinge_bending_energy, hinge_stiffness
+from ..energies.stretch import stretching_energy, two_node_blocks
+from ..geometry.centerline import first_mode_profile
+from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, structured_mesh
+from ..geometry.strip import InputError, Strip
+from ..solve.banded import BandAssembler
+from .base import BandedModel, Evaluation
+
+
+
+class PlateModel(BandedModel):
+    """The DEP of a Strip on a triangle mesh (structured with ~`triangles` triangles by default)."""
+
+    name = "plate"
+
+    def __init__(self, strip: Strip, triangles: int = DEFAULT_TRIANGLES, *, mesh: PlateMesh | None = None):
+        self.strip = strip
+        if mesh is None:
+            mesh = structured_mesh(strip.length, strip.width, triangles)
+        elif not (math.isclose(mesh.length, strip.length, rel_tol=1e-9)
+                  and math.isclose(mesh.width, strip.width, rel_tol=1e-9)):
+            raise InputError(f"mesh is {mesh.length:g} x {mesh.width:g} m but the strip is "
+                             f"{strip.length:g} x {strip.width:g} m; they must agree")
+        self.mesh = mesh
+        n_nodes = mesh.node_count
+        self.n_dof = 3 * n_nodes
+        self.node_dofs = 3 * np.arange(n_nodes)[:, None] + np.arange(3)[None, :]
+        left, right = np.flatnonzero(mesh.clamped_left), np.flatnonzero(mesh.clamped_right)
+        if not (np.array_equal(left, np.arange(len(left)))
+                and np.array_equal(right, np.arange(n_nodes - len(right), n_nodes))):
+            raise InputError("mesh nodes must be ordered along x (build meshes with mesh_from_arrays)")
+        self.left_nodes, self.right_nodes = left, right
+        self.free = slice(3 * len(left), 3 * (n_nodes - len(right)))
+        self.constrained = np.r_[np.arange(self.free.start), np.arange(self.free.stop, self.n_dof)]
+
+        E, b = strip.young_modulus, strip.thickness
+        rest = mesh.nodes
+        self.rest_edge_lengths = np.linalg.norm(rest[mesh.edges[:, 1]] - rest[mesh.edges[:, 0]], axis=1)
+        self.stretch_stiffness = E * b * mesh.edge_triangle_areas / self.rest_edge_lengths**2
+        hinge_edges = mesh.hinge_edges
+        self.hinge_stiffness = hinge_stiffness(self.rest_edge_lengths[hinge_edges],
+                                               mesh.edge_triangle_areas[hinge_edges], E * b**3 / 12.0)
+
+        self.bandwidth = 3 * mesh.bandwidth_nodes() + 2
+        self._assembler = BandAssembler(self.n_dof, self.bandwidth)
+        self._edge_dofs = self.node_dofs[mesh.edges].reshape(-1, 6)
+        self._triangle_dofs = self.node_dofs[mesh.triangles].reshape(-1, 9)
+        self._assembler.add_indexed_family(self._edge_dofs)
+        self._assembler.add_indexed_family(self._triangle_dofs)
+        hinge_dofs = self.node_dofs[mesh.hinges]  # (H, 4, 3), hinge order (v0, v1, a, b)
+        self._assembler.add_pair_family(hinge_dofs[:, HINGE_SLOTS_A].reshape(-1, 9),
+                                        hinge_dofs[:, HINGE_SLOTS_B].reshape(-1, 9))
+        self._centre = mesh.interpolation_matrix(np.array([[0.5 * strip.length, 0.0]]))
+        quarter = np.array([[0.25 * strip.length, 0.0], [0.75 * strip.length, 0.0]])
+        self._quarters = mesh.interpolation_matrix(quarter)
+
+    # ------------------------------------------------------------------ state
+    def rest_state(self) -> np.ndarray:
+        q = np.zeros(self.n_dof)
+        q[self.node_dofs[:, :2]] = self.mesh.nodes
+        return q
+
+    def reset(self) -> np.ndarray:
+        return self.rest_state()
+
+    def positions(self, q: np.ndarray) -> np.ndarray:
+        return q[self.node_dofs]
+
+    # the plate has no frames to carry between states
+    def commit(self, q: np.ndarray, evaluation: Evaluation | None = None) -> None:
+        pass
+
+    def save_frames(self):
+        return None
+
+    def restore_frames(self, saved) -> None:
+        pass
+
+    # ------------------------------------------------------------------ clamps
+    def clamp_values(self, compression: float, shear: float) -> np.ndarray:
+        """Clamped DOFs for clamp displacement (-dL, dW, 0) of the nodes with x >= L."""
+        values = self.rest_state()[self.constrained].copy()
+        right = self.node_dofs[self.right_nodes] - (self.free.stop - self.free.start)
+        values[right[:, 0]] -= compression
+        values[right[:, 1]] += shear
+        return values
+
+    def clamp_force(self, gradient: np.ndarray) -> np.ndarray:
+        """Force (N) the moving clamp applies to the plate: dE/d(clamp translation) (App. E)."""
+        return gradient[self.node_dofs[self.right_nodes]].sum(axis=0)
+
+    # ------------------------------------------------------------------ observables
+    def _interpolate(self, q: np.ndarray, where) -> np.ndarray:
+        nodes, weights = where
+        return np.einsum("qk,qkc->qc", weights, q[self.node_dofs][nodes])
+
+    def midpoint(self, q: np.ndarray) -> np.ndarray:
+        """Position of the plate's centre point (L/2, 0) (a node of the structured mesh)."""
+        return self._interpolate(q, self._centre)[0]
+
+    def mode_sign(self, mode: np.ndarray, direction: int) -> float:
+        """+1 raises the centre (direction=1) or the first half against the second (direction=0)."""
+        if direction:
+            return float(self._interpolate(mode, self._centre)[0, 2])
+        z = self._interpolate(mode, self._quarters)[:, 2]
+        return float(z[0] - z[1])
+
+    def centerline(self, q: np.ndarray, stations: int = 101) -> tuple[np.ndarray, np.ndarray]:
+        """Deformed positions (stations, 3) of the material line w = 0 at s = 0 .. L, and s."""
+        s = np.linspace(0.0, self.strip.length, stations)
+        where = self.mesh.interpolation_matrix(np.stack([s, np.zeros_like(s)], axis=1))
+        return self._interpolate(q, where), s
+
+    # ------------------------------------------------------------------ energy
+    def evaluate(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
+        mesh = self.mesh
+        x = q[self.node_dofs]
+        edges = x[mesh.edges[:, 1]] - x[mesh.edges[:, 0]]
+        e_s, g_s, h_s = stretching_energy(edges, self.rest_edge_lengths, self.stretch_stiffness,
+                                          gradient=gradient, hessian=hessian)
+        e_b, g_b, h_tri, h_hinge = hinge_bending_energy(x, mesh.triangles, mesh.hinge_triangles,
+                                                        mesh.hinge_edge_slots, self.hinge_stiffness,
+                                                        gradient=gradient, hessian=hessian)
+        parts = {"stretching": float(e_s.sum()), "bending": float(e_b.sum())}
+        out = Evaluation(energy=parts["stretching"] + parts["bending"], parts=parts)
+        if not gradient:
+            return out
+        if hessian:
+            g_edge, h_edge = two_node_blocks(g_s, h_s)
+        else:
+            g_edge = np.concatenate([-g_s, g_s], axis=1)
+        grad = np.bincount(self._edge_dofs.ravel(), weights=g_edge.ravel(), minlength=self.n_dof)
+        grad += np.bincount(self._triangle_dofs.ravel(), weights=g_b.ravel(), minlength=self.n_dof)
+        out.gradient = grad
+        if hessian:
+            out.hessian = self._assembler.assemble([h_edge, h_tri, h_hinge])
+        return out
+
+    # ------------------------------------------------------------------ metrics and scales
+    def eigenvalue_metric(self) -> tuple[np.ndarray, float]:
+        """Lumped metric (node area / W per coordinate) and the unit EI2 / L^4, as the rod's
+        (h per position): a mode uniform across the width has the rod's Rayleigh quotient."""
+        metric = np.repeat(self.mesh.node_areas / self.strip.width, 3)
+        return metric[self.free], self.strip.bending_stiffness / self.strip.length**4
+
+    def _typical_spacing(self) -> float:
+        return math.sqrt(4.0 * float(np.mean(self.mesh.triangle_areas)) / math.sqrt(3.0))
+
+    def residual_scale(self) -> np.ndarray:
+        """Per-node force unit: EI2 / L^2 times the node's share of a rod node of the same
+        spacing (node area / (W h)), so tolerances mean what they mean for the rod."""
+        s = self.strip
+        share = self.mesh.node_areas / (s.width * self._typical_spacing())
+        return np.repeat(s.bending_stiffness / s.length**2 * share, 3)
+
+    def residual_floor(self) -> float:
+        """Scaled residual that round-off alone produces: spring forces k_e L eps summed over a
+        node's six edges, in the residual units, times a safety factor of 10."""
+        floor = 6.0 * np.finfo(float).eps * float(self.stretch_stiffness.max()) * self.strip.length
+        return 10.0 * floor / float(self.residual_scale()[self.free].min())
+
+    def length_scale(self) -> np.ndarray:
+        return np.full(self.n_dof, self.strip.length)
+
+    def buckled_guess(self, compression: float, direction: int = 1) -> np.ndarray:
+        """The inextensible first-mode shape (uniform across the width) with chord L - dL."""
+        L = self.strip.length
+        x0 = self.mesh.nodes[:, 0]
+        X, Z = first_mode_profile(L, compression, np.clip(x0, 0.0, L), direction)
+        X = X + np.minimum(x0, 0.0) + np.maximum(x0 - L, 0.0)
+        q = self.rest_state()
+        q[self.node_dofs[:, 0]] = X
+        q[self.node_dofs[:, 2]] = Z
+        return q

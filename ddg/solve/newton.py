@@ -12,9 +12,15 @@ from dataclasses import dataclass
 import numpy as np
 
 
+#: Descending from a saddle to a stable branch (minimize=True) slides along a soft, curved
+#: valley: each step is limited by the stiff membrane (a plate of L/b ~ 1000 moves ~5e-4 L per
+#: iteration near a pitchfork), so it may take many more iterations than a load step.
+MINIMIZE_ITERATION_FACTOR = 15
+
+
 @dataclass
 class NewtonOptions:
-    max_iterations: int = 15  # per load step; four times as many when descending from a saddle
+    max_iterations: int = 15  # per load step; MINIMIZE_ITERATION_FACTOR times as many when descending from a saddle
     residual_tol: float = 1e-9   # max |dE/dq_i| / (EI2/L^2 or EI2/L), raised to the model's round-off floor
     step_tol: float = 1e-10      # Newton correction relative to L (positions) or 1 rad (angles)
     stagnation_residual: float = 1e-3  # the correction test applies only below this residual
@@ -56,7 +62,7 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
     ev = evaluation if evaluation is not None else model.evaluate(q)
     pd = None
     shift = 0.0
-    max_iterations = options.max_iterations * (4 if minimize else 1)
+    max_iterations = options.max_iterations * (MINIMIZE_ITERATION_FACTOR if minimize else 1)
     for iteration in range(max_iterations + 1):
         if not np.all(np.isfinite(ev.gradient)):
             return NewtonResult(q, ev, False, iteration, np.inf, pd, "non-finite gradient")

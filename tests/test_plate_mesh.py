@@ -1,0 +1,334 @@
+"""Triangle meshes of the flat strip: the structured mesh's construction, connectivity,
+hinge bookkeeping, normalisation and validation of arbitrary meshes, point location."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ddg.energies.hinge_bending import hinge_bending_energy
+from ddg.energies.stretch import stretching_energy
+from ddg.geometry.plate_mesh import mesh_from_arrays, structured_mesh
+from ddg.geometry.strip import InputError
+
+LENGTH = 1.0
+WIDTHS = (1 / 20, 1 / 6, 1 / 2)
+TARGETS = (500, 1000, 2000, 4000)
+ROUNDOFF = 1e-12
+
+
+# --------------------------------------------------------------------------- helpers
+def columns(mesh) -> np.ndarray:
+    """Distinct x of the structured mesh's node columns."""
+    return np.unique(np.round(mesh.nodes[:, 0], 12))
+
+
+def rows(mesh) -> int:
+    """n_y: the middle column x = L/2 is a regular one, with n_y + 1 nodes."""
+    return int(np.isclose(mesh.nodes[:, 0], 0.5 * mesh.length, rtol=0, atol=1e-12).sum()) - 1
+
+
+def signed_areas(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    p = points[triangles]
+    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+
+
+def edge_lengths(mesh, edges) -> np.ndarray:
+    return np.linalg.norm(mesh.nodes[edges[:, 1]] - mesh.nodes[edges[:, 0]], axis=1)
+
+
+def on_boundary_side(mesh, edges) -> np.ndarray:
+    """Edges with both ends on the same side of the rectangle [-c, L + c] x [-W/2, W/2]."""
+    x0, x1 = -mesh.clamp_depth, mesh.length + mesh.clamp_depth
+    p, q = mesh.nodes[edges[:, 0]], mesh.nodes[edges[:, 1]]
+    tol = 1e-12 * mesh.length
+    same = np.zeros(len(edges), dtype=bool)
+    for axis, value in ((0, x0), (0, x1), (1, -0.5 * mesh.width), (1, 0.5 * mesh.width)):
+        same |= (np.abs(p[:, axis] - value) < tol) & (np.abs(q[:, axis] - value) < tol)
+    return same
+
+
+def boundary_edges(mesh) -> np.ndarray:
+    """Edges of one triangle only: those not shared by a hinge."""
+    interior = np.zeros(len(mesh.edges), dtype=bool)
+    interior[mesh.hinge_edges] = True
+    return ~interior
+
+
+def count_bounds(length: float, width: float, target: int) -> tuple[float, float]:
+    """Bounds on (triangles in [0, L]) / target from structured_mesh's construction.
+
+    It aims at h_y* = sqrt(2 L W / (sqrt(3)/2 T)), i.e. nu = W / h_y* rows, and h_x = sqrt(3)/2
+    h_y, i.e. n* = 2 L n_y / (sqrt(3) W) columns; it rounds to an even n_y (|n_y - nu| <= 1)
+    and to n with |n - n*| <= 1, and holds n (2 n_y + 1) triangles in [0, L] (2 n_y + 1 per
+    column strip, against the ideal 2 n* nu^2 / n_y = T). So the ratio is
+    (n / n*) (n_y / nu)^2 (1 + 1 / (2 n_y)).
+    """
+    nu = width / math.sqrt(2.0 * length * width / (0.5 * math.sqrt(3.0) * target))
+    n_y_lo, n_y_hi = max(nu - 1.0, 2.0), nu + 1.0
+    n_star_lo = 2.0 * length * n_y_lo / (math.sqrt(3.0) * width)
+    lo = (1.0 - 1.0 / n_star_lo) * (n_y_lo / nu) ** 2
+    hi = (1.0 + 1.0 / n_star_lo) * (n_y_hi / nu) ** 2 * (1.0 + 1.0 / (2.0 * n_y_lo))
+    return lo, hi
+
+
+# --------------------------------------------------------------------------- structured mesh
+@pytest.mark.parametrize("width", WIDTHS)
+@pytest.mark.parametrize("target", TARGETS)
+def test_structured_mesh_is_a_clean_disc(width, target):
+    mesh = structured_mesh(LENGTH, width, target)
+    area = (mesh.length + 2 * mesh.clamp_depth) * width
+    assert np.all(mesh.triangle_areas > 0)  # counter-clockwise
+    assert mesh.triangle_areas.sum() == pytest.approx(area, rel=ROUNDOFF)
+    assert mesh.node_areas.sum() == pytest.approx(area, rel=ROUNDOFF)
+    assert mesh.edge_triangle_areas.sum() == pytest.approx(3 * area, rel=ROUNDOFF)  # each triangle on 3 edges
+
+    # a topological disc: Euler characteristic V - E + F = 1
+    assert mesh.node_count - len(mesh.edges) + mesh.triangle_count == 1
+    edges = mesh.edges
+    assert np.all(edges[:, 0] < edges[:, 1]) and len(np.unique(edges, axis=0)) == len(edges)
+    # every edge has one or two triangles (sum of 3 T edge slots), the single ones are
+    # exactly the edges along the rectangle's sides, which they cover once
+    boundary = boundary_edges(mesh)
+    assert 3 * mesh.triangle_count == 2 * len(mesh.hinges) + boundary.sum()
+    assert np.array_equal(boundary, on_boundary_side(mesh, edges))
+    perimeter = 2 * (mesh.length + 2 * mesh.clamp_depth + width)
+    assert edge_lengths(mesh, edges[boundary]).sum() == pytest.approx(perimeter, rel=ROUNDOFF)
+
+    # nodes ordered by x, then y within a column
+    x = np.round(mesh.nodes[:, 0], 12)
+    assert np.array_equal(np.lexsort((mesh.nodes[:, 1], x)), np.arange(mesh.node_count))
+
+    # the plate's centre is a node
+    tri, weights = mesh.locate([[0.5 * mesh.length, 0.0]])
+    corner = np.argmax(weights[0])
+    assert weights[0, corner] == pytest.approx(1.0, abs=ROUNDOFF)
+    assert np.allclose(mesh.nodes[mesh.triangles[tri[0], corner]], [0.5 * mesh.length, 0.0], rtol=0, atol=ROUNDOFF)
+
+
+@pytest.mark.parametrize("width", WIDTHS)
+@pytest.mark.parametrize("target", TARGETS)
+def test_structured_mesh_clamps_two_columns_at_each_end(width, target):
+    """Two columns per clamp, straddling the clamp line: x = -c and +c at the fixed end,
+    L - c and L + c at the moving one (c = half the column spacing), and nothing else."""
+    mesh = structured_mesh(LENGTH, width, target)
+    x = columns(mesh)
+    c = mesh.clamp_depth
+    assert c == pytest.approx(0.5 * np.mean(np.diff(x)), rel=1e-9)
+    assert x[:2] == pytest.approx([-c, c], abs=ROUNDOFF)
+    assert x[-2:] == pytest.approx([mesh.length - c, mesh.length + c], abs=ROUNDOFF)
+    left, right = mesh.clamped_left, mesh.clamped_right
+    assert np.array_equal(left, mesh.nodes[:, 0] < 0.5 * (x[1] + x[2]))
+    assert np.array_equal(right, mesh.nodes[:, 0] > 0.5 * (x[-2] + x[-3]))
+    # clamped-left nodes first, clamped-right last (the band structure relies on it)
+    assert np.all(np.flatnonzero(left) == np.arange(left.sum()))
+    assert np.all(np.flatnonzero(right) == np.arange(mesh.node_count - right.sum(), mesh.node_count))
+
+
+@pytest.mark.parametrize("width", WIDTHS)
+@pytest.mark.parametrize("target", TARGETS)
+def test_structured_mesh_size_and_shape_follow_the_construction(width, target):
+    mesh = structured_mesh(LENGTH, width, target)
+    n_y = rows(mesh)
+    x = columns(mesh)
+    h_x, h_y = float(np.mean(np.diff(x))), width / n_y
+    strips = len(x) - 1
+    n = LENGTH / h_x
+    assert n == pytest.approx(round(n), abs=1e-9)  # the clamp lines x = 0, L lie midway between columns
+    n = round(n)
+    assert n_y % 2 == 0
+    assert mesh.triangle_count == strips * (2 * n_y + 1)
+    nu = width / math.sqrt(2.0 * LENGTH * width / (0.5 * math.sqrt(3.0) * target))
+    assert abs(n_y - nu) <= 1.0
+    n_star = 2.0 * LENGTH * n_y / (math.sqrt(3.0) * width)
+    assert abs(n - n_star) <= 1.0
+    lo, hi = count_bounds(LENGTH, width, target)
+    assert lo <= n * (2 * n_y + 1) / target <= hi
+
+    # shapes: 2 half triangles per column strip on the edges y = +-W/2 (legs h_x, h_y / 2),
+    # all others with sides h_y and sqrt(h_x^2 + h_y^2 / 4), equilateral up to h_x / (sqrt(3)/2
+    # h_y) = n* / n in [n* / (n* + 1), n* / (n* - 1)]
+    p = mesh.nodes[mesh.triangles]
+    sides = np.sort(np.linalg.norm(p - p[:, [1, 2, 0]], axis=2), axis=1)
+    half = np.isclose(mesh.triangle_areas, 0.25 * h_x * h_y, rtol=1e-9)
+    assert half.sum() == 2 * strips
+    assert np.allclose(np.sort(sides[half], axis=1), np.sort([h_x, 0.5 * h_y, math.hypot(h_x, 0.5 * h_y)]), rtol=1e-9)
+    assert np.all(np.isclose(np.abs(p[half][:, :, 1]), 0.5 * width).sum(axis=1) == 2)
+    full = ~half
+    assert np.allclose(mesh.triangle_areas[full], 0.5 * h_x * h_y, rtol=1e-9)
+    ratio_lo, ratio_hi = n_star / (n_star + 1), n_star / (n_star - 1)
+    diagonal_lo, diagonal_hi = math.sqrt(0.75 * ratio_lo**2 + 0.25), math.sqrt(0.75 * ratio_hi**2 + 0.25)
+    aspect = sides[full, 2] / sides[full, 0]
+    assert np.all(aspect <= max(diagonal_hi, 1 / diagonal_lo) * (1 + 1e-9))
+    assert np.max(np.abs(sides[full] / h_y - 1.0)) <= max(diagonal_hi - 1, 1 - diagonal_lo) + 1e-9
+
+
+def test_tiny_triangle_count_is_rejected():
+    for bad in (5, 15, 2000.0, True):
+        with pytest.raises(InputError, match="integer >= 16"):
+            structured_mesh(LENGTH, 0.05, bad)
+
+
+def test_large_mesh_connectivity():
+    """~50k triangles: connectivity is built by sorting, O(N log N) (no timing asserted)."""
+    width, target = 0.5, 50_000
+    mesh = structured_mesh(LENGTH, width, target)
+    lo, hi = count_bounds(LENGTH, width, target)
+    assert lo * target <= mesh.triangle_count <= hi * target * (1 + 2 * mesh.clamp_depth / LENGTH)
+    assert mesh.node_count - len(mesh.edges) + mesh.triangle_count == 1
+    boundary = boundary_edges(mesh)
+    assert np.array_equal(boundary, on_boundary_side(mesh, mesh.edges))
+    assert len(mesh.hinges) == len(mesh.edges) - boundary.sum()
+    h = mesh.hinges
+    assert np.all(signed_areas(mesh.nodes, h[:, [0, 1, 2]]) > 0)
+    assert np.all(signed_areas(mesh.nodes, h[:, [1, 0, 3]]) > 0)
+    # the band: a hinge spans at most two neighbouring columns, about 2 (n_y + 2) nodes
+    assert mesh.bandwidth_nodes() <= 2 * (rows(mesh) + 2)
+
+
+# --------------------------------------------------------------------------- hinges
+def irregular_mesh():
+    """A structured mesh with its interior nodes jittered (still a valid, non-equilateral mesh)."""
+    base = structured_mesh(LENGTH, 1 / 6, 300)
+    rng = np.random.default_rng(7)
+    nodes = base.nodes.copy()
+    interior = ~base.clamped_left & ~base.clamped_right & (np.abs(nodes[:, 1]) < 0.5 * base.width - 1e-12)
+    nodes[interior] += 0.15 * base.clamp_depth * rng.uniform(-1, 1, (interior.sum(), 2))
+    return mesh_from_arrays(nodes, base.triangles, LENGTH, base.width)
+
+
+@pytest.mark.parametrize("make", (lambda: structured_mesh(LENGTH, 0.2, 600), irregular_mesh),
+                         ids=("structured", "jittered"))
+def test_hinges_are_consistently_oriented_pairs(make):
+    mesh = make()
+    h, tri, slots = mesh.hinges, mesh.hinge_triangles, mesh.hinge_edge_slots
+    # triangle a = (v0, v1, a) and b = (v1, v0, b) are both counter-clockwise in the plane
+    assert np.all(signed_areas(mesh.nodes, h[:, [0, 1, 2]]) > 0)
+    assert np.all(signed_areas(mesh.nodes, h[:, [1, 0, 3]]) > 0)
+    t = mesh.triangles
+    # the listed triangles and local edge slots are those of the hinge
+    for side, order in ((0, [0, 1, 2]), (1, [1, 0, 3])):
+        for k in range(3):
+            assert np.array_equal(t[tri[:, side], (slots[:, side] + k) % 3], h[:, order[k]])
+    assert np.all(tri[:, 0] != tri[:, 1]) and len(np.unique(h, axis=0)) == len(h)
+    # one hinge per interior edge
+    assert np.array_equal(mesh.edges[mesh.hinge_edges], np.sort(h[:, :2], axis=1))
+    assert len(np.unique(mesh.hinge_edges)) == len(h) == len(mesh.edges) - boundary_edges(mesh).sum()
+    # shared edge slots: each triangle has at most 3 hinges, boundary triangles fewer
+    per_triangle = np.bincount(tri.ravel(), minlength=mesh.triangle_count)
+    assert per_triangle.max() == 3 and per_triangle.min() >= 1
+    assert mesh.bandwidth_nodes() == np.max(h.max(axis=1) - h.min(axis=1))
+
+
+# --------------------------------------------------------------------------- mesh_from_arrays
+def deformation(points: np.ndarray) -> np.ndarray:
+    """A smooth large deformation of the reference plane (a function of position only)."""
+    x, y = points[:, 0], points[:, 1]
+    z = 0.3 * np.sin(2.0 * x) + y * np.sin(0.7 * x) + 0.2 * x * y
+    return np.stack([0.9 * x + 0.1 * y**2, y * np.cos(0.7 * x), z], axis=1)
+
+
+def plate_energy(mesh) -> float:
+    x = deformation(mesh.nodes)
+    edges = mesh.edges
+    rest = edge_lengths(mesh, edges)
+    springs = mesh.edge_triangle_areas / rest**2
+    stretch = stretching_energy(x[edges[:, 1]] - x[edges[:, 0]], rest, springs, gradient=False)[0]
+    bend = hinge_bending_energy(x, mesh.triangles, mesh.hinge_triangles, mesh.hinge_edge_slots,
+                                np.ones(len(mesh.hinges)), gradient=False)[0]
+    return stretch.sum() + bend.sum()
+
+
+def test_mesh_from_arrays_normalises_a_scrambled_copy():
+    """Shuffled nodes, a third of the triangles clockwise, shifted and with constant z, plus an
+    unused node: the same mesh after normalisation (nodes, triangles up to relabelling, CCW,
+    clamp zone) and the same energy for the same deformation."""
+    mesh = structured_mesh(LENGTH, 0.25, 400)
+    rng = np.random.default_rng(11)
+    perm = rng.permutation(mesh.node_count)
+    inverse = np.argsort(perm)
+    nodes = mesh.nodes[perm] + [3.7, -1.2]
+    nodes = np.vstack([nodes, [[50.0, 50.0]]])  # unused
+    nodes = np.c_[nodes, np.full(len(nodes), 0.25)]
+    triangles = inverse[mesh.triangles]
+    flip = rng.random(len(triangles)) < 1 / 3
+    triangles[flip] = triangles[flip][:, [0, 2, 1]]
+    triangles = triangles[rng.permutation(len(triangles))]
+
+    copy = mesh_from_arrays(nodes, triangles, LENGTH, 0.25)
+    assert copy.clamp_depth == pytest.approx(mesh.clamp_depth, rel=1e-9)
+    assert copy.node_count == mesh.node_count and copy.triangle_count == mesh.triangle_count
+    assert np.all(copy.triangle_areas > 0)
+    # match nodes by position
+    order_a = np.lexsort(np.round(mesh.nodes, 9).T)
+    order_b = np.lexsort(np.round(copy.nodes, 9).T)
+    assert np.allclose(mesh.nodes[order_a], copy.nodes[order_b], rtol=0, atol=1e-12)
+    to_original = np.empty(copy.node_count, dtype=int)
+    to_original[order_b] = order_a
+    same = {tuple(sorted(t)) for t in mesh.triangles.tolist()}
+    assert {tuple(sorted(t)) for t in to_original[copy.triangles].tolist()} == same
+    assert len(copy.hinges) == len(mesh.hinges) and len(copy.edges) == len(mesh.edges)
+    assert np.array_equal(copy.clamped_left[order_b], mesh.clamped_left[order_a])
+    assert np.array_equal(copy.clamped_right[order_b], mesh.clamped_right[order_a])
+    assert plate_energy(copy) == pytest.approx(plate_energy(mesh), rel=1e-12)
+
+
+def _bad_inputs():
+    mesh = structured_mesh(LENGTH, 0.25, 200)
+    nodes, tris, w = mesh.nodes, mesh.triangles, mesh.width
+    span = mesh.length + 2 * mesh.clamp_depth
+    bottom = np.flatnonzero(np.isclose(nodes[:, 1], -0.5 * w))[:3]  # three collinear nodes
+    bumpy = np.c_[nodes, 1e-3 * np.sin(7 * nodes[:, 0])]
+    return {
+        "wrong width": ((nodes, tris, LENGTH, 1.1 * w), "width"),
+        "no clamp zone": ((nodes, tris, span, w), "clamp zone"),
+        "clamp depth inconsistent": ((nodes, tris, LENGTH, w, 2 * mesh.clamp_depth), "clamp zone"),
+        "not flat": ((bumpy, tris, LENGTH, w), "not flat"),
+        "degenerate triangle": ((nodes, np.vstack([tris, bottom]), LENGTH, w), "degenerate"),
+        "index too large": ((nodes, np.where(tris == tris.max(), len(nodes), tris), LENGTH, w), "outside"),
+        "negative index": ((nodes, np.where(tris == 0, -1, tris), LENGTH, w), "outside"),
+        "float indices": ((nodes, tris.astype(float), LENGTH, w), "integer"),
+        "nodes shape": ((np.c_[nodes, nodes], tris, LENGTH, w), "shape"),
+        "triangles shape": ((nodes, tris[:, :2], LENGTH, w), "shape"),
+    }
+
+
+BAD_INPUTS = _bad_inputs()
+
+
+@pytest.mark.parametrize("case", sorted(BAD_INPUTS))
+def test_mesh_from_arrays_rejects_bad_input(case):
+    args, keyword = BAD_INPUTS[case]
+    nodes, tris, length, width, *depth = args
+    kwargs = {"clamp_depth": depth[0]} if depth else {}
+    with pytest.raises(InputError) as info:
+        mesh_from_arrays(nodes, tris, length, width, **kwargs)
+    message = str(info.value)
+    assert keyword in message and "\n" not in message
+
+
+# --------------------------------------------------------------------------- locate
+def test_interpolation_is_exact_for_linear_fields():
+    mesh = structured_mesh(LENGTH, 0.2, 800)
+    rng = np.random.default_rng(5)
+    c, w = mesh.clamp_depth, mesh.width
+    points = np.c_[rng.uniform(-c, mesh.length + c, 300), rng.uniform(-0.5 * w, 0.5 * w, 300)]
+    points = np.vstack([points, mesh.nodes[::17]])  # nodes and points on edges too
+    tri, weights = mesh.locate(points)
+    assert np.all(weights >= -1e-10) and np.allclose(weights.sum(axis=1), 1.0, rtol=0, atol=ROUNDOFF)
+    nodes, w_interp = mesh.interpolation_matrix(points)
+    assert np.array_equal(nodes, mesh.triangles[tri])
+    field = 0.3 + 2.0 * mesh.nodes[:, 0] - 5.0 * mesh.nodes[:, 1]
+    exact = 0.3 + 2.0 * points[:, 0] - 5.0 * points[:, 1]
+    assert np.allclose(np.sum(w_interp * field[nodes], axis=1), exact, rtol=0, atol=1e-12)
+    # the weights reproduce the points themselves (barycentric coordinates)
+    assert np.allclose(np.einsum("qk,qkd->qd", w_interp, mesh.nodes[nodes]), points, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("point", ([1.2, 0.0], [0.5, 0.11], [-0.2, 0.0]))
+def test_locate_rejects_points_outside(point):
+    mesh = structured_mesh(LENGTH, 0.2, 800)
+    with pytest.raises(InputError, match="outside the mesh"):
+        mesh.locate([[0.5, 0.0], point])

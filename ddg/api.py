@@ -4,18 +4,54 @@ from __future__ import annotations
 import platform
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import scipy
 
 from .geometry.strip import InputError, LoadingProtocol, Strip
-from .io import write_path_csv, write_summary_json
+from .io import write_centerline_csv, write_path_csv, write_summary_json
 from .observables import observe
 from .solve.continuation import ContinuationFailure, ContinuationOptions, PathFollower
 
 DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000}
+
+
+#: Stations along the centerline exported per recorded step (centerline.csv).
+CENTERLINE_STATIONS = 101
+
+
+def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None):
+    """The model `name` of the strip at `resolution` (rod: nodes M; plate: target triangles).
+
+    mesh (plate only): a PlateMesh, the path of a mesh file meshio reads, or "gmsh" for an
+    unstructured gmsh mesh with about `resolution` triangles; default the structured mesh.
+    """
+    cls = _model_class(name)
+    resolution = DEFAULT_RESOLUTION[name] if resolution is None else resolution
+    if mesh is None:
+        return cls(strip, resolution)
+    if name != "plate":
+        raise InputError(f"a mesh is used by the plate model only, not {name!r}")
+    from .geometry.plate_mesh import PlateMesh
+
+    if not isinstance(mesh, PlateMesh):
+        from .geometry import mesh_io
+
+        if str(mesh) == "gmsh":
+            mesh = mesh_io.gmsh_mesh(strip.length, strip.width, resolution)
+        else:
+            mesh = mesh_io.read_mesh(mesh, strip.length, strip.width)
+    return cls(strip, mesh=mesh)
+
+
+def _frame_writer(model, directory: Path):
+    from .frames_output import FrameWriter, polyline_cells
+
+    if hasattr(model, "mesh"):
+        return FrameWriter(directory, model.mesh)
+    return FrameWriter(directory, polyline_cells(model.nodes), reference=model.rest_state()[model.node_dofs])
 
 
 def _model_class(name: str):
@@ -34,6 +70,7 @@ class SimulationResult:
     summary: dict
     final_state: object = None
     model: object = None
+    centerlines: list = field(default_factory=list)  # per recorded row: (stations, 3) positions of w = 0
 
     @property
     def converged(self) -> bool:
@@ -46,7 +83,13 @@ class SimulationResult:
     def write(self, out: str | Path) -> None:
         out = Path(out)
         write_path_csv(out / "path.csv", self.rows)
+        if self.centerlines:
+            write_centerline_csv(out / "centerline.csv", self.rows, self.centerlines, self.strip_length)
         write_summary_json(out / "summary.json", self.summary)
+
+    @property
+    def strip_length(self) -> float:
+        return float(self.summary["scene"]["length"])
 
 
 class _Progress:
@@ -84,7 +127,8 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
             **strip.as_dict(),
             **protocol.as_dict(strip),
             "resolution": resolution,
-            "clamp_convention": "clamped edges straddle the clamp points; free length exactly L",
+            "clamp_convention": "clamped edges (rod) / the two clamped node columns (plate) straddle the clamp "
+                                "points; free length exactly L",
         },
         "H_mid_over_L_compressed": None,
         "dW_max_over_L": strip.shear_limit(protocol.compression_ratio * L) / L,
@@ -96,6 +140,7 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
         "wall_time_s": None,
         "converged": False,
         "message": "",
+        "mesh": model.mesh.as_dict() if hasattr(model, "mesh") else None,
         "lambda_min_normalisation": "lowest eigenvalue of K v = lambda D v (lumped metric D), times L^4 / EI2",
         "versions": versions(),
     }
@@ -111,20 +156,26 @@ def simulate(
     progress: bool = False,
     solver: str = "static",
     dynamic_options=None,
+    mesh=None,
+    frames: bool = False,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
     solver="static" (default): Newton continuation of equilibria; solver="dynamic": the
     paper's implicit-Euler time marching (Eq. 7) with the clamp moved at a finite speed
     (rod only; see ddg.solve.dynamics). Returns every recorded equilibrium (rows of
-    path.csv) and the summary; writes both to `out` if given, also when the run stops early
-    (the converged part of the path is kept).
+    path.csv), the summary and the deformed centerline (w = 0) per row; writes them to `out`
+    (path.csv, summary.json, centerline.csv) if given, also when the run stops early (the
+    converged part of the path is kept). frames=True also writes out/frames/frame_NNNNN.vtu per
+    recorded step and out/frames/frames.pvd (ParaView). mesh: see make_model.
     """
     if solver not in ("static", "dynamic"):
         raise InputError(f"solver = {solver!r} is not available; choose 'static' or 'dynamic'")
     if solver == "dynamic":
         if model != "rod":
             raise InputError(f"solver = 'dynamic' is available for model 'rod' only, not {model!r}")
+        if frames or mesh is not None:
+            raise InputError("frames and mesh are options of the static solver; drop them or use solver='static'")
         from .solve.dynamics import simulate_dynamic
 
         result = simulate_dynamic(strip, protocol, DEFAULT_RESOLUTION["rod"] if resolution is None else resolution,
@@ -136,10 +187,12 @@ def simulate(
         raise InputError(f"strip = {strip!r} must be a ddg.Strip")
     if not isinstance(protocol, LoadingProtocol):
         raise InputError(f"protocol = {protocol!r} must be a ddg.LoadingProtocol")
-    cls = _model_class(model)
-    resolution = DEFAULT_RESOLUTION[model] if resolution is None else resolution
+    resolution = DEFAULT_RESOLUTION.get(model) if resolution is None else resolution
     shear_ratio = protocol.resolved_shear_ratio(strip)
-    instance = cls(strip, resolution)
+    instance = make_model(model, strip, resolution, mesh)
+    if frames and out is None:
+        raise InputError("frames=True needs an output directory (out)")
+    writer = _frame_writer(instance, Path(out) / "frames") if frames else None
     options = options or ContinuationOptions()
     follower = PathFollower(instance, options)
     L = strip.length
@@ -147,6 +200,7 @@ def simulate(
     dW = protocol.shear_sign * shear_ratio * L
 
     rows: list[dict] = []
+    centerlines: list[np.ndarray] = []
     progress_bar = _Progress(protocol.compression_steps + protocol.shear_steps + 1, progress)
     summary = base_summary(model, strip, protocol, resolution, instance)
     t0 = time.perf_counter()
@@ -155,6 +209,10 @@ def simulate(
     def record(stage):
         row = observe(instance, state, stage, options.eigenvalues)
         rows.append(row)
+        centerlines.append(instance.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
+        if writer is not None:
+            writer.write(instance.positions(state.q), step=len(rows) - 1, dL_over_L=row["dL_over_L"],
+                         dW_over_L=row["dW_over_L"], stage=stage)
         progress_bar.update(f"{stage} dL/L={row['dL_over_L']:.4f} dW/L={row['dW_over_L']:.4f}")
 
     try:
@@ -180,7 +238,9 @@ def simulate(
         summary["newton_iterations"] = follower.newton_iterations
         summary["wall_time_s"] = time.perf_counter() - t0
         summary["recorded_steps"] = len(rows)
-        result = SimulationResult(rows, summary, state, instance)
+        if writer is not None:
+            writer.close()
+        result = SimulationResult(rows, summary, state, instance, centerlines)
         if out is not None:
             result.write(out)
     return result

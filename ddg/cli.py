@@ -26,7 +26,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m ddg", description="DDG solvers for pre-buckled strips under shear.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sim = sub.add_parser("simulate", help="compress by dL, then shear by dW; write path.csv and summary.json")
-    sim.add_argument("--model", default="rod", help="rod (default)")
+    sim.add_argument("--model", default="rod", choices=("rod", "plate"),
+                     help="rod (DAR, default) or plate (DEP on a triangle mesh)")
     sim.add_argument("--width-ratio", type=float, default=0.05, help="W/L (default 0.05)")
     sim.add_argument("--compression-ratio", type=float, default=0.5, help="dL/L (default 0.5)")
     sim.add_argument("--shear-ratio", type=float, default=None, help="largest dW/L (default dW_max/L, Eq. B.1)")
@@ -34,7 +35,13 @@ def build_parser() -> argparse.ArgumentParser:
                      help="L/b (default: b = 0.127 mm with clamps 75 mm apart, i.e. 1181 at dL/L = 1/2)")
     sim.add_argument("--poisson-ratio", type=float, default=0.0, help="nu in [0, 0.5) (default 0)")
     sim.add_argument("--young-modulus", type=float, default=100e9, help="E in Pa (default 100 GPa)")
-    sim.add_argument("--resolution", type=int, default=None, help="rod: node count M (default 100)")
+    sim.add_argument("--resolution", type=int, default=None,
+                     help="rod: node count M (default 100); plate: target triangle count N_mesh (default 2000)")
+    sim.add_argument("--mesh", default=None,
+                     help="plate: a mesh file meshio reads (e.g. gmsh .msh) spanning L + 2c by W, or 'gmsh' for an "
+                          "unstructured gmsh mesh of --resolution triangles (default: structured near-equilateral)")
+    sim.add_argument("--frames", action="store_true",
+                     help="also write OUT/frames/frame_NNNNN.vtu per recorded step and OUT/frames/frames.pvd (ParaView)")
     sim.add_argument("--compression-steps", type=int, default=40, help="recorded compression steps (default 40)")
     sim.add_argument("--shear-steps", type=int, default=120, help="recorded shear steps (default 120)")
     sim.add_argument("--shear-direction", type=int, choices=(1, -1), default=1, help="+1 or -1 (default +1)")
@@ -70,7 +77,8 @@ def cmd_simulate(args) -> int:
             raise InputError(f"--clamp-speed = {args.clamp_speed} must be a positive speed in m/s")
         dynamic_options = DynamicOptions(clamp_speed=args.clamp_speed)
     result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
-                      progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options)
+                      progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options,
+                      mesh=args.mesh, frames=args.frames)
     s = result.summary
     if not args.quiet:
         keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",

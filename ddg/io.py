@@ -62,6 +62,20 @@ def write_summary_json(path: Path, summary: dict) -> None:
     atomic_write_text(Path(path), json.dumps(_json_safe(summary), indent=2, sort_keys=False) + "\n")
 
 
+def write_centerline_csv(path: Path, rows: list[dict], centerlines: list, length: float) -> None:
+    """centerline.csv: the deformed material line w = 0 (the rod's centerline) per recorded row,
+    columns row (index into path.csv), stage, dL_over_L, dW_over_L, s_over_L, x/y/z_over_L."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(["row", "stage", "dL_over_L", "dW_over_L", "s_over_L", "x_over_L", "y_over_L", "z_over_L"])
+    for index, (row, points) in enumerate(zip(rows, centerlines)):
+        stations = len(points)
+        for k, p in enumerate(points / length):
+            writer.writerow([index, row["stage"], _format(row["dL_over_L"]), _format(row["dW_over_L"]),
+                             repr(k / (stations - 1)), repr(float(p[0])), repr(float(p[1])), repr(float(p[2]))])
+    atomic_write_text(Path(path), buf.getvalue())
+
+
 def read_path_csv(path: Path) -> list[dict]:
     with open(path, newline="") as fh:
         return list(csv.DictReader(fh))

@@ -10,12 +10,16 @@ Stiffnesses (derived in ddg.energies.hinge_bending and tested):
   sqrt(3)/2 E b; the continuum limit is an isotropic membrane of 2D modulus E b and Poisson
   ratio 1/3 (boundary edges carry half, so the membrane is uniform up to the edge).
 - bending: c_h = D |e_bar|^2 / (2 (A_a + A_b)) per hinge with D = E b^3 / 12: on equilateral
-  triangles exactly Eq. (11b)'s E b^3 / (12 sqrt(3)), whose continuum limit is the plate
-  bending stiffness D (Seung and Nelson 1988; bending Poisson ratio 0, as the rod with nu = 0:
-  twisting a strip costs GJ = 2 D W).
+  triangles exactly Eq. (11b)'s E b^3 / (12 sqrt(3)), whose continuum limit has the plate
+  bending stiffness D (Seung and Nelson 1988) and a Gaussian modulus of -4/3 D, i.e. a
+  bending Poisson ratio nu_b = -1/3 (measured in tests/test_plate_energies.py). Consequences
+  for a strip, compared with the rod at nu = 0: a narrow plate bends as a beam of stiffness
+  D (1 - nu_b^2) W = 8/9 EI2 (its Euler loads, tested) and twists with GJ = 2 D (1 - nu_b) W,
+  4/3 of the rod's E W b^3 / 6; the stiffness ratio that sets the thresholds differs by 3/2.
 
-Clamps (section 4): every node with x <= 0 (two columns on the structured mesh) moves with
-the fixed clamp and every node with x >= L with the moving one; the free plate is exactly L.
+Clamps (section 4): the two node columns at each end (every node within half a column
+spacing of a clamp line, ddg.geometry.plate_mesh) move rigidly with their clamp; they
+straddle the clamp lines so the free plate is exactly L.
 """
 from __future__ import annotations
 
@@ -130,7 +134,7 @@ class PlateModel(BandedModel):
         z = self._interpolate(mode, self._quarters)[:, 2]
         return float(z[0] - z[1])
 
-    def centerline(self, q: np.ndarray, stations: int = 101) -> tuple[np.ndarray, np.ndarray]:
+    def centerline_positions(self, q: np.ndarray, stations: int = 101) -> tuple[np.ndarray, np.ndarray]:
         """Deformed positions (stations, 3) of the material line w = 0 at s = 0 .. L, and s."""
         s = np.linspace(0.0, self.strip.length, stations)
         where = self.mesh.interpolation_matrix(np.stack([s, np.zeros_like(s)], axis=1))

@@ -109,6 +109,13 @@ class RodModel(BandedModel):
         """Centerline point at rest arclength s = L/2 (linear along the edge, O(h^2))."""
         return self.centerline.interpolate_at(q[self.node_dofs], 0.5 * self.strip.length)
 
+    def centerline_positions(self, q: np.ndarray, stations: int = 101) -> tuple[np.ndarray, np.ndarray]:
+        """Deformed centerline positions (stations, 3) at rest arclengths s = 0 .. L, and s."""
+        s = np.linspace(0.0, self.strip.length, stations)
+        x = q[self.node_dofs]
+        sn = self.centerline.node_arclength
+        return np.stack([np.interp(s, sn, x[:, k]) for k in range(3)], axis=1), s
+
     def mode_sign(self, mode: np.ndarray, direction: int) -> float:
         """Sign convention of a mode: +1 raises the midpoint (direction=1) or the first half
         of the strip against the second (direction=0, the '+' branches US+ and S+)."""

@@ -51,13 +51,50 @@ class PathFollower:
         self.options = options or ContinuationOptions()
         self.substep = 1.0
         self.newton_iterations = 0
+        self._history: list[tuple[np.ndarray, np.ndarray]] = []  # (load, q) of the last equilibria on this branch
+
+    # ------------------------------------------------------------------ predictors
+    def _remember(self, state: State, restart: bool = False) -> None:
+        if restart:
+            self._history = []
+        self._history = (self._history + [(np.array([state.compression, state.shear]), state.q.copy())])[-3:]
+
+    def _extrapolate(self, compression: float, shear: float) -> np.ndarray | None:
+        """Polynomial extrapolation (secant, or quadratic through three points) of the last
+        equilibria on the current branch to the new load, if they lie on the same load line.
+
+        On a curved branch it captures the second-order (membrane) part of the motion that the
+        tangent predictor misses, which for thin plates decides whether Newton converges."""
+        if len(self._history) < 2:
+            return None
+        target = np.array([compression, shear])
+        last = self._history[-1][0]
+        direction = target - last
+        norm2 = float(direction @ direction)
+        if norm2 == 0.0:
+            return None
+        params, qs = [], []
+        for load, q in self._history:
+            offset = load - last
+            if abs(offset[0] * direction[1] - offset[1] * direction[0]) > 1e-9 * norm2 + 1e-300:
+                params, qs = [], []  # an earlier point off the line: keep only the later ones
+                continue
+            params.append(float(offset @ direction) / norm2)
+            qs.append(q)
+        if len(params) < 2 or len(set(params)) < len(params):
+            return None
+        # Lagrange weights at t = 1 (the target); the last point sits at t = 0
+        weights = [np.prod([(1.0 - tj) / (ti - tj) for tj in params if tj is not ti]) for ti in params]
+        return sum(w * q for w, q in zip(weights, qs))
 
     # ------------------------------------------------------------------ pieces
     def rest(self) -> State:
         q = self.model.reset()
         ev = self.model.evaluate(q)
         stable = self.model.free_matrix(ev.hessian).cholesky()
-        return State(q, ev, 0.0, 0.0, stable)
+        state = State(q, ev, 0.0, 0.0, stable)
+        self._remember(state, restart=True)
+        return state
 
     def start_compression(self, compression: float, direction: int = 1) -> State:
         """First buckled equilibrium at a small compression, from an inextensible guess."""
@@ -72,7 +109,10 @@ class PathFollower:
             if result.converged:
                 state = State(result.q, result.evaluation, compression, 0.0, bool(result.positive_definite),
                               result.iterations)
-                return self._ensure_stable(state, direction)
+                state = self._ensure_stable(state, direction)
+                if state is not None:
+                    self._remember(state, restart=True)
+                return state
             compression *= 0.5
         raise ContinuationFailure(
             f"Newton failed to find the buckled state at the start of compression (tried dL/L from "
@@ -106,6 +146,7 @@ class PathFollower:
                 continue
             iterations += new.iterations
             switched = switched or new.branch_switched
+            self._remember(new, restart=new.branch_switched)
             if new.iterations <= self.options.easy_iterations:
                 self.substep = min(1.0, 2.0 * self.substep)
             state, t = new, t_next
@@ -118,19 +159,33 @@ class PathFollower:
         return self.model.strip.length
 
     def _step(self, state: State, compression: float, shear: float, patient: bool = False) -> State | None:
+        """One substep: predictor (extrapolated from the branch, else the tangent), Newton; on an
+        unstable result, branch switching. None if it does not converge."""
         model = self.model
         saved = model.save_frames()
         new_clamps = model.clamp_values(compression, shear)
-        dq_c = new_clamps - state.q[model.constrained]
-        K = model.free_matrix(state.evaluation.hessian)
-        q = state.q.copy()
-        q[model.constrained] = new_clamps
-        q[model.free] -= K.solve(model.coupling(state.evaluation.hessian, dq_c))
         opts = self.options.newton
         if patient:
             opts = replace(opts, max_iterations=4 * opts.max_iterations)
-        result = newton(model, q, opts)
-        self.newton_iterations += result.iterations
+        result = None
+        extrapolated = self._extrapolate(compression, shear) if state.q is self._history[-1][1] or \
+            np.array_equal(state.q, self._history[-1][1]) else None
+        if extrapolated is not None:
+            q = extrapolated
+            q[model.constrained] = new_clamps
+            result = newton(model, q, opts)
+            self.newton_iterations += result.iterations
+            if not result.converged:
+                model.restore_frames(saved)
+                result = None
+        if result is None:
+            dq_c = new_clamps - state.q[model.constrained]
+            K = model.free_matrix(state.evaluation.hessian)
+            q = state.q.copy()
+            q[model.constrained] = new_clamps
+            q[model.free] -= K.solve(model.coupling(state.evaluation.hessian, dq_c))
+            result = newton(model, q, opts)
+            self.newton_iterations += result.iterations
         if not result.converged:
             model.restore_frames(saved)
             return None

@@ -91,11 +91,14 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
         slope = float(r @ dq)
         alpha = 1.0
         accepted = False
-        for _ in range(options.max_line_search):
+        for trial in range(options.max_line_search):
             q_try = q.copy()
             q_try[free] += alpha * dq
-            ev_try = model.evaluate(q_try)
-            if np.isfinite(ev_try.energy) and np.all(np.isfinite(ev_try.gradient)):
+            # the full step is usually accepted: evaluate everything there; shorter trials need
+            # only the energy (or the gradient), the Hessian follows once one is accepted
+            full = trial == 0
+            ev_try = model.evaluate(q_try, gradient=full or not use_energy, hessian=full)
+            if np.isfinite(ev_try.energy) and (ev_try.gradient is None or np.all(np.isfinite(ev_try.gradient))):
                 if use_energy:
                     ok = ev_try.energy <= ev.energy + 1e-4 * alpha * min(slope, 0.0) + 1e-12 * abs(ev.energy)
                 else:
@@ -103,10 +106,17 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
                     ok = res_try <= (1.0 - 1e-4 * alpha) * res
                 if ok:
                     accepted = True
+                    if not full:
+                        ev_try = model.evaluate(q_try)
                     break
             alpha *= 0.5
         if not accepted:
             return NewtonResult(q, ev, False, iteration + 1, res, pd, "line search failed")
+        if not minimize:
+            first_residual = res if iteration == 0 else first_residual
+            if iteration >= 6 and res > first_residual:
+                # six iterations without any net progress: this start is outside Newton's basin
+                return NewtonResult(q, ev, False, iteration + 1, res, pd, "no progress in 6 iterations")
         model.commit(q_try, ev_try)
         q, ev = q_try, ev_try
     res = scaled_residual(model, ev.gradient)

@@ -166,7 +166,7 @@ class PathFollower:
         new_clamps = model.clamp_values(compression, shear)
         opts = self.options.newton
         if patient:
-            opts = replace(opts, max_iterations=4 * opts.max_iterations)
+            opts = replace(opts, max_iterations=2 * opts.max_iterations, give_up_after=2 * opts.give_up_after if opts.give_up_after else None, give_up_ratio=0.5)
         result = None
         extrapolated = self._extrapolate(compression, shear) if state.q is self._history[-1][1] or \
             np.array_equal(state.q, self._history[-1][1]) else None

@@ -25,6 +25,12 @@ class NewtonOptions:
     step_tol: float = 1e-10      # Newton correction relative to L (positions) or 1 rad (angles)
     stagnation_residual: float = 1e-3  # the correction test applies only below this residual
     max_line_search: int = 30
+    # fail fast: a load step whose residual has not fallen below give_up_ratio of its start
+    # after give_up_after iterations is outside Newton's basin (converging steps take ~3
+    # iterations); the caller then halves the step. None disables (near thresholds, where
+    # Newton converges only linearly).
+    give_up_after: int | None = 5
+    give_up_ratio: float = 0.05
 
 
 @dataclass
@@ -91,7 +97,8 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
         slope = float(r @ dq)
         alpha = 1.0
         accepted = False
-        for trial in range(options.max_line_search):
+        # a load step whose Newton direction needs more than 1/1024 of a step is better halved
+        for trial in range(options.max_line_search if minimize else min(options.max_line_search, 10)):
             q_try = q.copy()
             q_try[free] += alpha * dq
             # the full step is usually accepted: evaluate everything there; shorter trials need
@@ -114,9 +121,10 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
             return NewtonResult(q, ev, False, iteration + 1, res, pd, "line search failed")
         if not minimize:
             first_residual = res if iteration == 0 else first_residual
-            if iteration >= 6 and res > first_residual:
-                # six iterations without any net progress: this start is outside Newton's basin
-                return NewtonResult(q, ev, False, iteration + 1, res, pd, "no progress in 6 iterations")
+            if options.give_up_after is not None and iteration >= options.give_up_after \
+                    and res > options.give_up_ratio * first_residual:
+                return NewtonResult(q, ev, False, iteration + 1, res, pd,
+                                    f"no progress in {options.give_up_after} iterations")
         model.commit(q_try, ev_try)
         q, ev = q_try, ev_try
     res = scaled_residual(model, ev.gradient)

@@ -95,3 +95,45 @@ def test_narrow_straight_plate_buckles_at_the_clamped_euler_loads():
         assert second / first == pytest.approx(EULER_ANTISYMMETRIC / EULER_SYMMETRIC, rel=5e-3)
         errors.append(abs(first / EULER_SYMMETRIC - 1))
     assert errors[1] < 0.5 * errors[0] and errors[1] < 0.01, errors
+
+
+def shear_path(model, width_ratio, resolution, shear_ratio, steps):
+    strip = ddg.Strip.from_ratios(width_ratio, 0.5)
+    protocol = ddg.LoadingProtocol(0.5, shear_ratio=shear_ratio, compression_steps=10, shear_steps=steps)
+    result = ddg.simulate(strip, protocol, model=model, resolution=resolution)
+    assert result.converged, result.summary["message"]
+    return result
+
+
+def first_switch(result):
+    """dW/L of the first shear step that left an unstable branch (the U -> US pitchfork), bracketed
+    by the step before it."""
+    dw = result.column("dW_over_L", "shear")
+    switched = result.column("branch_switched", "shear").astype(bool)
+    assert switched.any(), "no branch switch on this path"
+    k = int(np.argmax(switched))
+    return dw[k - 1], dw[k]
+
+
+def test_narrow_plate_and_rod_agree_on_the_U_branch():
+    """W/L = 1/20, dL/L = 1/2: before the pitchfork (dW/L <= 0.3) the plate's H_mid(dW) follows
+    the rod's within 1 % of L (paper: DAR and DEP match for W/L ~ 1/20). Measured: 6e-5 L at
+    the start of shear, growing to 7.3e-3 L at dW/L = 0.3 as the plate, 4/3 stiffer in
+    torsion (its bending Poisson ratio is -1/3), nears its pitchfork."""
+    rod = shear_path("rod", 1 / 20, 100, 0.30, 15)
+    plate = shear_path("plate", 1 / 20, 600, 0.30, 15)
+    h_rod = rod.column("H_mid_over_L", "shear")
+    h_plate = plate.column("H_mid_over_L", "shear")
+    assert np.max(np.abs(h_rod - h_plate)) < 1e-2, np.abs(h_rod - h_plate)
+    assert not plate.column("branch_switched", "shear").any()
+
+
+def test_wide_plate_leaves_the_U_branch_well_before_the_narrow_one():
+    """Paper: dW1/L ~ 0.17 at W/L = 1/2 against ~ 0.36 at W/L = 1/20."""
+    wide = shear_path("plate", 1 / 2, 500, 0.22, 22)
+    narrow = shear_path("plate", 1 / 20, 500, 0.38, 19)
+    wide_before, wide_after = first_switch(wide)
+    narrow_before, narrow_after = first_switch(narrow)
+    assert 0.12 < wide_after and wide_before < 0.22, (wide_before, wide_after)
+    assert 0.31 < narrow_after and narrow_before < 0.39, (narrow_before, narrow_after)
+    assert narrow_before - wide_after > 0.1

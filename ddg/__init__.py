@@ -1,5 +1,7 @@
 """Discrete-differential-geometry solvers for thin elastic strips (rod, plate, ribbon)."""
 from .geometry.strip import InputError, LoadingProtocol, Strip, shear_limit
+from .solve.continuation import ContinuationOptions
+from .solve.newton import NewtonOptions
 
 __version__ = "0.1.0"
 
@@ -11,4 +13,5 @@ def simulate(*args, **kwargs):
     return _simulate(*args, **kwargs)
 
 
-__all__ = ["InputError", "LoadingProtocol", "Strip", "shear_limit", "simulate", "__version__"]
+__all__ = ["ContinuationOptions", "InputError", "LoadingProtocol", "NewtonOptions", "Strip", "shear_limit",
+           "simulate", "__version__"]

@@ -236,8 +236,8 @@ def plate_energy(mesh) -> float:
     rest = edge_lengths(mesh, edges)
     springs = mesh.edge_triangle_areas / rest**2
     stretch = stretching_energy(x[edges[:, 1]] - x[edges[:, 0]], rest, springs, gradient=False)[0]
-    bend = hinge_bending_energy(x, mesh.triangles, mesh.hinge_triangles, mesh.hinge_edge_slots,
-                                np.ones(len(mesh.hinges)), gradient=False)[0]
+    bend = hinge_bending_energy(x, mesh.triangles, mesh.hinge_triangles, np.ones(len(mesh.hinges)),
+                                gradient=False)[0]
     return stretch.sum() + bend.sum()
 
 

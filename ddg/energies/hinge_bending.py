@@ -32,9 +32,19 @@ from __future__ import annotations
 
 import numpy as np
 
-#: Local positions of triangle a = (v0, v1, a) and triangle b = (v1, v0, b) in a hinge (v0, v1, a, b).
-HINGE_SLOTS_A = np.array([0, 1, 2])
-HINGE_SLOTS_B = np.array([1, 0, 3])
+def _bilinear_positions():
+    """Flat positions in a 9 x 9 block of the entries (a, b) of blocks (i, i+1) and (i+1, i)."""
+    upper, lower = [], []
+    for i in range(3):
+        j = (i + 1) % 3
+        for a in range(3):
+            for b in range(3):
+                upper.append((3 * i + a) * 9 + 3 * j + b)
+                lower.append((3 * j + a) * 9 + 3 * i + b)
+    return np.array(upper), np.array(lower)
+
+
+_BILINEAR_UPPER, _BILINEAR_LOWER = _bilinear_positions()
 
 
 def cross_matrix(v: np.ndarray) -> np.ndarray:
@@ -64,20 +74,16 @@ def hinge_stiffness(rest_edge_lengths: np.ndarray, rest_pair_areas: np.ndarray, 
     return 0.5 * bending_stiffness * rest_edge_lengths**2 / rest_pair_areas
 
 
-def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: np.ndarray,
-                         hinge_edge_slots: np.ndarray, stiffness: np.ndarray, *, gradient: bool = True,
-                         hessian: bool = True):
+def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: np.ndarray, stiffness: np.ndarray,
+                         *, gradient: bool = True, hessian: bool = True):
     """Eq. (11b) for the deformed node positions x (N, 3).
 
-    hinge_edge_slots (H, 2): the local edge index k (edge from vertex k to k+1) of the shared
-    edge in triangle a and in triangle b (PlateMesh.hinge_edge_slots).
-
     Returns (energy per hinge (H,), gradient per triangle (T, 9), Hessian per triangle
-    (T, 9, 9), cross blocks per hinge (H, 9, 9)) -- the gradient and triangle blocks in the
-    triangles' vertex order; the cross block C couples triangle a's vertices (v0, v1, a) (rows)
-    with triangle b's (v1, v0, b) (columns) and enters the Hessian as C + C^T
-    (`expand_hinge_blocks` gives the (H, 12, 12) form). Unrequested parts are None. Assembly
-    sums the blocks (ddg.models.plate).
+    (T, 9, 9), cross blocks per hinge (H, 9, 9)), all in the triangles' own vertex order: the
+    cross block C couples triangle a's nine coordinates (rows) with triangle b's (columns) and
+    enters the Hessian as C + C^T (the shared edge's nodes appear in both, where C + C^T
+    lands on the same entries twice). Unrequested parts are None. Assembly sums the blocks
+    (ddg.models.plate).
     """
     n, double_area = triangle_normals(x, triangles)
     tri_a, tri_b = hinge_triangles[:, 0], hinge_triangles[:, 1]
@@ -102,32 +108,14 @@ def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: 
     h_u /= (double_area**2)[:, None, None]
     St = S.transpose(0, 2, 1)
     hess_tri = S @ h_u @ St
-    G = cross_matrix(g_u)
-    view = hess_tri.reshape(count, 3, 3, 3, 3)  # (vertex i, coord, vertex j, coord)
-    for i in range(3):
-        j = (i + 1) % 3
-        view[:, i, :, j, :] -= G
-        view[:, j, :, i, :] += G
+    # B(g): blocks (i, i+1) = -[g]x, (i+1, i) = +[g]x; [g]x is antisymmetric, so both are
+    # +/- the same nine numbers at fixed positions of the flattened 9 x 9 block
+    G = cross_matrix(g_u).reshape(count, 9)
+    flat = hess_tri.reshape(count, 81)
+    flat[:, _BILINEAR_UPPER] -= np.tile(G, 3)
+    flat[:, _BILINEAR_LOWER] += np.tile(G, 3)
     hess_tri *= -2.0
 
-    J = (projector / double_area[:, None, None]) @ St  # (T, 3 normal components, 9)
-    # columns of J_a in hinge order (v0, v1, a): vertices k_a, k_a + 1, k_a + 2 of triangle a;
-    # of J_b in the order (v1, v0, b): vertices k_b, k_b + 1, k_b + 2 of triangle b
-    coords = np.arange(3)[None, None, :]
-    columns_a = (3 * ((hinge_edge_slots[:, :1] + np.arange(3)) % 3)[:, :, None] + coords).reshape(-1, 1, 9)
-    columns_b = (3 * ((hinge_edge_slots[:, 1:] + np.arange(3)) % 3)[:, :, None] + coords).reshape(-1, 1, 9)
-    J_a = np.take_along_axis(J[tri_a], columns_a, axis=2)
-    J_b = np.take_along_axis(J[tri_b], columns_b, axis=2)
-    cross = (-2.0 * stiffness)[:, None, None] * (J_a.transpose(0, 2, 1) @ J_b)  # rows (v0, v1, a), cols (v1, v0, b)
+    Jt = S @ (projector / double_area[:, None, None])  # J^T, (T, 9, 3): P is symmetric
+    cross = Jt[tri_a] @ (Jt[tri_b].transpose(0, 2, 1) * (-2.0 * stiffness)[:, None, None])
     return energy, grad, hess_tri, cross
-
-
-def expand_hinge_blocks(cross: np.ndarray) -> np.ndarray:
-    """The symmetric (H, 12, 12) hinge blocks C + C^T in hinge order (v0, v1, a, b) from the
-    cross blocks C (rows: triangle a's (v0, v1, a), columns: triangle b's (v1, v0, b))."""
-    rows_a = (3 * HINGE_SLOTS_A[:, None] + np.arange(3)).ravel()
-    cols_b = (3 * HINGE_SLOTS_B[:, None] + np.arange(3)).ravel()
-    blocks = np.zeros((len(cross), 12, 12))
-    blocks[:, rows_a[:, None], cols_b[None, :]] = cross
-    blocks[:, cols_b[:, None], rows_a[None, :]] += cross.transpose(0, 2, 1)
-    return blocks

@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from ..energies.hinge_bending import HINGE_SLOTS_A, HINGE_SLOTS_B, hinge_bending_energy, hinge_stiffness
+from ..energies.hinge_bending import hinge_bending_energy, hinge_stiffness
 from ..energies.stretch import stretching_energy, two_node_blocks
 from ..geometry.centerline import first_mode_profile
 from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, structured_mesh
@@ -76,9 +76,8 @@ class PlateModel(BandedModel):
         self._triangle_dofs = self.node_dofs[mesh.triangles].reshape(-1, 9)
         self._assembler.add_indexed_family(self._edge_dofs)
         self._assembler.add_indexed_family(self._triangle_dofs)
-        hinge_dofs = self.node_dofs[mesh.hinges]  # (H, 4, 3), hinge order (v0, v1, a, b)
-        self._assembler.add_pair_family(hinge_dofs[:, HINGE_SLOTS_A].reshape(-1, 9),
-                                        hinge_dofs[:, HINGE_SLOTS_B].reshape(-1, 9))
+        self._assembler.add_pair_family(self._triangle_dofs[mesh.hinge_triangles[:, 0]],
+                                        self._triangle_dofs[mesh.hinge_triangles[:, 1]])
         self._centre = mesh.interpolation_matrix(np.array([[0.5 * strip.length, 0.0]]))
         quarter = np.array([[0.25 * strip.length, 0.0], [0.75 * strip.length, 0.0]])
         self._quarters = mesh.interpolation_matrix(quarter)
@@ -148,8 +147,7 @@ class PlateModel(BandedModel):
         e_s, g_s, h_s = stretching_energy(edges, self.rest_edge_lengths, self.stretch_stiffness,
                                           gradient=gradient, hessian=hessian)
         e_b, g_b, h_tri, h_hinge = hinge_bending_energy(x, mesh.triangles, mesh.hinge_triangles,
-                                                        mesh.hinge_edge_slots, self.hinge_stiffness,
-                                                        gradient=gradient, hessian=hessian)
+                                                        self.hinge_stiffness, gradient=gradient, hessian=hessian)
         parts = {"stretching": float(e_s.sum()), "bending": float(e_b.sum())}
         out = Evaluation(energy=parts["stretching"] + parts["bending"], parts=parts)
         if not gradient:

@@ -32,6 +32,7 @@ class BandAssembler:
         flat = (a - b)[None, :] * self.n + offsets[:, None] + b[None, :]
         local = a * size + b
         self._families.append((flat.ravel(), local, "contiguous"))
+        self._all_flat = None
         return len(self._families) - 1
 
     def add_indexed_family(self, dofs: np.ndarray) -> int:
@@ -43,6 +44,7 @@ class BandAssembler:
             raise ValueError("element block wider than the band")
         flat = ((rows - cols) * self.n + cols)[lower]
         self._families.append((flat, np.flatnonzero(lower.ravel()), "indexed"))
+        self._all_flat = None
         return len(self._families) - 1
 
     def add_pair_family(self, row_dofs: np.ndarray, col_dofs: np.ndarray) -> int:
@@ -55,19 +57,27 @@ class BandAssembler:
         low, high = np.minimum(rows, cols), np.maximum(rows, cols)
         flat = ((high - low) * self.n + low).ravel()
         self._families.append((flat, np.where(rows == cols, 2.0, 1.0).ravel(), "pair"))
+        self._all_flat = None
         return len(self._families) - 1
 
     def assemble(self, blocks: list[np.ndarray]) -> "SymmetricBanded":
-        total = np.zeros((self.bandwidth + 1) * self.n)
+        """Sum the element blocks (one array per family, in the order added) into the band:
+        the lower-band entries of all families are gathered into one buffer, one bincount."""
+        if getattr(self, "_all_flat", None) is None:
+            self._all_flat = np.concatenate([f for f, _, _ in self._families])
+            self._buffer = np.empty(len(self._all_flat))
+        start = 0
         for (flat, local, kind), values in zip(self._families, blocks):
+            out = self._buffer[start:start + len(flat)]
             if kind == "indexed":  # positions in the whole stack of blocks
-                picked = values.ravel()[local]
+                np.take(values.ravel(), local, out=out)
             elif kind == "pair":  # local holds the multiplicity (2 on the diagonal)
-                picked = values.ravel() * local
+                np.multiply(values.ravel(), local, out=out)
             else:
                 m = values.shape[1]
-                picked = values.reshape(-1, m * m)[:, local].ravel()
-            total += np.bincount(flat, weights=picked, minlength=total.size)
+                out[:] = values.reshape(-1, m * m)[:, local].ravel()
+            start += len(flat)
+        total = np.bincount(self._all_flat, weights=self._buffer, minlength=(self.bandwidth + 1) * self.n)
         return SymmetricBanded(total.reshape(self.bandwidth + 1, self.n))
 
 

@@ -32,6 +32,8 @@ class ContinuationOptions:
     eigenvalues: bool = True           # compute lambda_min at every recorded equilibrium
     kick: float = 1e-3                 # size of the push off an unstable state, relative to L
     jump_substep: float = 1.0 / 64     # below this substep a failing branch is left by energy descent
+    predictor: str = "secant"
+    grow_after: int = 2                # easy substeps in a row before the substep doubles           # "secant" (extrapolate the branch), "tangent", or "both" (secant, then tangent)
 
 
 @dataclass
@@ -51,6 +53,7 @@ class PathFollower:
         self.options = options or ContinuationOptions()
         self.substep = 1.0
         self.newton_iterations = 0
+        self._easy_streak = 0
         self._history: list[tuple[np.ndarray, np.ndarray]] = []  # (load, q) of the last equilibria on this branch
 
     # ------------------------------------------------------------------ predictors
@@ -136,6 +139,7 @@ class PathFollower:
                 # the branch has ended (a fold): let the strip snap to the nearest stable state
                 new = self._jump(state, *load)
             if new is None:
+                self._easy_streak = 0
                 self.substep *= 0.5
                 if self.substep < self.options.min_substep:
                     raise ContinuationFailure(
@@ -148,7 +152,11 @@ class PathFollower:
             switched = switched or new.branch_switched
             self._remember(new, restart=new.branch_switched)
             if new.iterations <= self.options.easy_iterations:
-                self.substep = min(1.0, 2.0 * self.substep)
+                self._easy_streak += 1
+                if self._easy_streak >= self.options.grow_after:
+                    self.substep = min(1.0, 2.0 * self.substep)
+            else:
+                self._easy_streak = 0
             state, t = new, t_next
         state.iterations = iterations
         state.branch_switched = switched
@@ -168,8 +176,9 @@ class PathFollower:
         if patient:
             opts = replace(opts, max_iterations=2 * opts.max_iterations, give_up_after=2 * opts.give_up_after if opts.give_up_after else None, give_up_ratio=0.5)
         result = None
-        extrapolated = self._extrapolate(compression, shear) if state.q is self._history[-1][1] or \
-            np.array_equal(state.q, self._history[-1][1]) else None
+        extrapolated = None
+        if self.options.predictor != "tangent" and np.array_equal(state.q, self._history[-1][1]):
+            extrapolated = self._extrapolate(compression, shear)
         if extrapolated is not None:
             q = extrapolated
             q[model.constrained] = new_clamps
@@ -178,7 +187,7 @@ class PathFollower:
             if not result.converged:
                 model.restore_frames(saved)
                 result = None
-        if result is None:
+        if result is None and (extrapolated is None or self.options.predictor != "secant"):
             dq_c = new_clamps - state.q[model.constrained]
             K = model.free_matrix(state.evaluation.hessian)
             q = state.q.copy()
@@ -186,7 +195,7 @@ class PathFollower:
             q[model.free] -= K.solve(model.coupling(state.evaluation.hessian, dq_c))
             result = newton(model, q, opts)
             self.newton_iterations += result.iterations
-        if not result.converged:
+        if result is None or not result.converged:
             model.restore_frames(saved)
             return None
         new = State(result.q, result.evaluation, compression, shear, bool(result.positive_definite), result.iterations)

@@ -1,0 +1,758 @@
+"""Speed benchmark of the plate solver's full path (compression to dL/L = 1/2, then shear to dW_max).
+
+    .venv/bin/python -m benchmarks.plate_path [--triangles 500 1000 2000 4000] [--width-ratio 1/6]
+        [--shear-steps 120] [--shear-ratio R] [--compression-steps 40] [--repeat 1]
+        [--out benchmarks/results] [--timeout 1800]
+
+For each target triangle count N it runs
+
+    ddg.simulate(ddg.Strip.from_ratios(W/L, 0.5),
+                 ddg.LoadingProtocol(0.5, None, compression_steps=40, shear_steps=120),
+                 model="plate", resolution=N)
+
+in a fresh child process (so a run that exceeds --timeout can be stopped) and reports the actual
+triangle count and free DOFs, the Hessian bandwidth, the wall and CPU time (best of --repeat),
+Newton iterations, whether the path completed (and the library's message), the dW/L reached,
+the evaluations per Newton iteration (full Hessian, gradient only, energy only) and the split of
+the time per Newton iteration between
+
+  (a) element evaluation + assembly: PlateModel.evaluate, split further into the energy kernels
+      (the ddg.energies.* functions PlateModel calls: stretching_energy, two_node_blocks,
+      hinge_bending_energy), the band assembly (BandAssembler.assemble) and the rest of
+      evaluate (gathering positions, edge vectors, gradient bincounts);
+  (b) factorisation and solves: SymmetricBanded.cholesky / .solve and any direct call of
+      scipy.linalg.cholesky_banded / cho_solve_banded / solve_banded (and scipy.sparse.linalg
+      splu / spsolve / factorized, in case the library starts using them);
+  (c) eigenvalue work: ddg.solve.stability.lowest_modes, SymmetricBanded.lowest_eigenpairs
+      (and scipy.sparse.linalg.eigsh / scipy.linalg.eig_banded called directly);
+  (d) other: the rest of the wall time (Newton and continuation bookkeeping, predictors, band
+      restriction and copies, observables, model and mesh set-up).
+
+Method: those functions are wrapped with timers at run time (time.perf_counter around each
+call), in the child process only, and restored afterwards; the library is not modified. A
+call made inside another timed call of categories (a)-(c) is counted once, by the outermost
+one: the Cholesky factorisations and Lanczos solves inside lowest_eigenpairs are eigenvalue
+work, a kernel call is counted inside (a). The kernels/assembly sub-split is taken the same
+way one level down (the outermost kernel or assembly call inside evaluate). Per-function
+inclusive times, split by the category of the enclosing call, are kept in the JSON
+("calls.by_function"). The wrappers cost ~1 us per call, negligible against the ms-scale
+calls they time.
+
+Writes OUT/plate_path.json (all numbers, per-step detail and machine info) and OUT/plate_path.md
+(the tables), both atomically (ddg.io.atomic_write_text). Not part of the test run.
+"""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import functools
+import inspect
+import io
+import json
+import math
+import multiprocessing as mp
+import os
+import sys
+import time
+import traceback
+from collections import defaultdict
+from fractions import Fraction
+from pathlib import Path
+
+from benchmarks.rod_path import _fmt, _load, fit_slope, machine_info as _rod_machine_info, source_fingerprint
+from ddg.io import atomic_write_text
+
+WIDTH_RATIO = 1.0 / 6.0
+COMPRESSION_RATIO = 0.5
+COMPRESSION_STEPS = 40
+SHEAR_STEPS = 120
+TRIANGLES = [500, 1000, 2000, 4000]
+
+#: level 1: where the wall time goes; level 2: inside PlateModel.evaluate
+LEVEL1 = ("evaluate", "linalg", "eigen")
+LEVEL2 = ("kernels", "assembly")
+CATEGORY_LABELS = {
+    "evaluate": "(a) element evaluation + assembly (PlateModel.evaluate)",
+    "kernels": "(a1) energy/gradient/Hessian kernels (ddg.energies.* called by PlateModel.evaluate)",
+    "assembly": "(a2) band assembly (BandAssembler.assemble)",
+    "evaluate_rest": "(a3) rest of PlateModel.evaluate (gathers, edge vectors, gradient bincounts)",
+    "linalg": "(b) factorisation and solves (SymmetricBanded.cholesky, .solve; scipy cholesky_banded, "
+              "cho_solve_banded, solve_banded called directly)",
+    "eigen": "(c) eigenvalue work (stability.lowest_modes, SymmetricBanded.lowest_eigenpairs, with their own "
+             "factorisations and Lanczos solves)",
+    "other": "(d) everything else (Newton/continuation bookkeeping, predictors, band restriction and copies, "
+             "observables, model set-up)",
+}
+
+
+# ---------------------------------------------------------------------------- instrumentation
+class _Instrument:
+    """Timing wrappers on library functions, installed and removed around one run."""
+
+    def __init__(self):
+        self.stack: list[tuple[str, str]] = []             # (key, category) of the timed calls in progress
+        self.level1 = defaultdict(float)                    # category -> time of outermost level-1 calls
+        self.level1_calls = defaultdict(int)
+        self.level2 = defaultdict(float)                    # (category, enclosing level-1 or "outside") -> time
+        self.level2_calls = defaultdict(int)
+        self.by_function = defaultdict(lambda: defaultdict(lambda: [0, 0.0]))  # key -> context -> [calls, s]
+        self.eval_kinds = defaultdict(lambda: [0, 0.0])     # "full" / "gradient" / "energy" -> [calls, s]
+        self.factorisations = defaultdict(lambda: defaultdict(int))  # context -> "ok"/"not PD" -> count
+        self.eigen_paths = defaultdict(lambda: [0, 0.0])
+        self.newton_calls: list[dict] = []
+        self.steps: list[dict] = []
+        self._current_step: dict | None = None
+        self._patches: list[tuple[object, str, object]] = []
+        self.notes: list[str] = []
+
+    # -- the timer
+    def _timed(self, key: str, category: str, original, after=None):
+        inst = self
+
+        @functools.wraps(original)
+        def wrapper(*args, **kwargs):
+            stack = inst.stack
+            outer1 = next((c for _, c in stack if c in LEVEL1), None)
+            inside2 = any(c in LEVEL2 for _, c in stack)
+            recursive = any(k == key for k, _ in stack)
+            stack.append((key, category))
+            t0 = time.perf_counter()
+            try:
+                result = original(*args, **kwargs)
+            finally:
+                dt = time.perf_counter() - t0
+                stack.pop()
+                if not recursive:
+                    slot = inst.by_function[key][outer1 or "top"]
+                    slot[0] += 1
+                    slot[1] += dt
+                if category in LEVEL1 and outer1 is None:
+                    inst.level1[category] += dt
+                    inst.level1_calls[category] += 1
+                if category in LEVEL2 and not inside2:
+                    inst.level2[(category, outer1 or "outside")] += dt
+                    inst.level2_calls[(category, outer1 or "outside")] += 1
+            if after is not None:
+                after(args, kwargs, result, dt, outer1)
+            return result
+
+        wrapper.__wrapped_by_benchmark__ = True
+        return wrapper
+
+    def _set(self, owner, name: str, replacement) -> None:
+        self._patches.append((owner, name, getattr(owner, name) if isinstance(owner, type(sys))
+                              else owner.__dict__[name]))
+        setattr(owner, name, replacement)
+
+    def _patch_method(self, cls, name: str, key: str, category: str, after=None, required=False) -> bool:
+        if name not in cls.__dict__:
+            if required:
+                raise RuntimeError(f"{cls.__name__}.{name} not found: the benchmark needs updating")
+            self.notes.append(f"{cls.__name__}.{name} not found; not timed")
+            return False
+        self._set(cls, name, self._timed(key, category, cls.__dict__[name], after))
+        return True
+
+    def _patch_function(self, module, name: str, key: str, category: str) -> bool:
+        """Wrap module.name and every reference to the same function object in loaded ddg modules
+        (they import functions by name, e.g. `from .stability import lowest_modes`)."""
+        original = getattr(module, name, None)
+        if original is None or getattr(original, "__wrapped_by_benchmark__", False):
+            if original is None:
+                self.notes.append(f"{module.__name__}.{name} not found; not timed")
+            return False
+        wrapper = self._timed(key, category, original)
+        self._set(module, name, wrapper)
+        for mod_name, mod in list(sys.modules.items()):
+            if mod is module or mod is None or not (mod_name == "ddg" or mod_name.startswith("ddg.")):
+                continue
+            for attr, value in list(vars(mod).items()):
+                if value is original:
+                    self._set(mod, attr, wrapper)
+        return True
+
+    def install(self) -> None:
+        import scipy.linalg
+        import scipy.sparse.linalg
+
+        import ddg.api  # noqa: F401  (loads every module whose references are rebound below)
+        from ddg.models import plate
+        from ddg.solve import banded, continuation, stability
+        from ddg.solve.banded import BandAssembler, SymmetricBanded
+
+        inst = self
+
+        # (a) evaluate, with the kind of evaluation
+        evaluate = plate.PlateModel.__dict__["evaluate"]
+        signature = inspect.signature(evaluate)
+
+        def classify(args, kwargs, result, dt, outer1):
+            if outer1 is not None:
+                return
+            try:
+                bound = signature.bind(*args, **kwargs)
+                bound.apply_defaults()
+                grad, hess = bool(bound.arguments.get("gradient", True)), bool(bound.arguments.get("hessian", True))
+                kind = "full" if (grad and hess) else ("gradient" if grad else "energy")
+            except TypeError:
+                kind = "unknown"
+            inst.eval_kinds[kind][0] += 1
+            inst.eval_kinds[kind][1] += dt
+
+        self._patch_method(plate.PlateModel, "evaluate", "PlateModel.evaluate", "evaluate", classify, required=True)
+        # (a1) kernels: the ddg.energies functions the plate module calls
+        kernels = [name for name, value in vars(plate).items()
+                   if inspect.isfunction(value) and (value.__module__ or "").startswith("ddg.energies")]
+        for name in kernels:
+            self._patch_function(plate, name, f"{plate.__dict__[name].__module__}.{name}", "kernels")
+        if not kernels:
+            self.notes.append("no ddg.energies functions found in ddg.models.plate; kernel time not separated")
+        # (a2) assembly
+        self._patch_method(BandAssembler, "assemble", "BandAssembler.assemble", "assembly")
+
+        # (b) factorisation and solves
+        chol = SymmetricBanded.__dict__["cholesky"]
+
+        @functools.wraps(chol)
+        def cholesky_counting(self_, *a, **k):
+            fresh = not getattr(self_, "_cholesky_tried", True)
+            out = chol(self_, *a, **k)
+            if fresh:
+                context = next((c for _, c in inst.stack[:-1] if c in LEVEL1), None) or "top"
+                inst.factorisations[context]["positive definite" if out else "not PD"] += 1
+            return out
+
+        self._set(SymmetricBanded, "cholesky", self._timed("SymmetricBanded.cholesky", "linalg", cholesky_counting))
+        self._patch_method(SymmetricBanded, "solve", "SymmetricBanded.solve", "linalg")
+        for name in ("cholesky_banded", "cho_solve_banded", "solve_banded"):
+            self._patch_function(scipy.linalg, name, f"scipy.linalg.{name}", "linalg")
+        for name in ("splu", "spsolve", "factorized"):
+            self._patch_function(scipy.sparse.linalg, name, f"scipy.sparse.linalg.{name}", "linalg")
+
+        # (c) eigenvalue work
+        self._patch_function(stability, "lowest_modes", "stability.lowest_modes", "eigen")
+
+        def eig_path(args, kwargs, result, dt, outer1):
+            self_ = args[0]
+            count = kwargs.get("count", args[1] if len(args) > 1 else 1)
+            vectors = kwargs.get("vectors", args[2] if len(args) > 2 else False)
+            if self_.n <= 4 * min(count, self_.n) + 20:
+                path = "dense eigh"
+            elif getattr(self_, "_cholesky", None) is not None:
+                path = "Lanczos on A^-1 (A positive definite)"
+            else:
+                path = "Lanczos on (A + sigma I)^-1 (A indefinite, shift search)"
+            path += ", with vectors" if vectors else ""
+            inst.eigen_paths[path][0] += 1
+            inst.eigen_paths[path][1] += dt
+
+        self._patch_method(SymmetricBanded, "lowest_eigenpairs", "SymmetricBanded.lowest_eigenpairs", "eigen", eig_path)
+        self._patch_function(scipy.sparse.linalg, "eigsh", "scipy.sparse.linalg.eigsh", "eigen")
+        self._patch_function(scipy.linalg, "eig_banded", "scipy.linalg.eig_banded", "eigen")
+        self._patch_function(scipy.linalg, "eigvals_banded", "scipy.linalg.eigvals_banded", "eigen")
+        del banded  # imported so its `sla` module attribute lookups see the patched scipy functions
+
+        # Newton solves: who called them, iterations, converged or not
+        newton = continuation.__dict__["newton"]
+
+        @functools.wraps(newton)
+        def newton_counting(model, q, *args, **kwargs):
+            caller = sys._getframe(1).f_code.co_name
+            result = newton(model, q, *args, **kwargs)
+            rec = {"caller": caller, "iterations": int(result.iterations), "converged": bool(result.converged),
+                   "minimize": bool(kwargs.get("minimize", False))}
+            inst.newton_calls.append(rec)
+            step = inst._current_step
+            if step is not None:
+                step["newton_solves"] += 1
+                step["iterations_all"] += rec["iterations"]
+                if not rec["converged"]:
+                    step["failed_solves"] += 1
+                    step["iterations_failed"] += rec["iterations"]
+            return result
+
+        self._set(continuation, "newton", newton_counting)
+
+        PF = continuation.PathFollower
+
+        def stepper(name):
+            original = PF.__dict__[name]
+            sig = inspect.signature(original)
+
+            @functools.wraps(original)
+            def wrapper(self_, *args, **kwargs):
+                L = self_.model.strip.length
+                try:
+                    bound = sig.bind(self_, *args, **kwargs).arguments
+                    compression, shear = float(bound.get("compression", math.nan)), float(bound.get("shear", 0.0))
+                except (TypeError, ValueError):
+                    compression, shear = math.nan, math.nan
+                step = {"dL_over_L": compression / L, "dW_over_L": shear / L, "newton_solves": 0,
+                        "iterations_all": 0, "failed_solves": 0, "iterations_failed": 0}
+                inst._current_step = step
+                t0 = time.perf_counter()
+                try:
+                    return original(self_, *args, **kwargs)
+                finally:
+                    step["time_s"] = time.perf_counter() - t0
+                    inst._current_step = None
+                    inst.steps.append(step)
+
+            return wrapper
+
+        for name in ("advance", "start_compression"):
+            if name in PF.__dict__:
+                self._set(PF, name, stepper(name))
+
+    def restore(self) -> None:
+        while self._patches:
+            owner, name, original = self._patches.pop()
+            setattr(owner, name, original)
+
+
+# ---------------------------------------------------------------------------- one run (child)
+def _run_once(triangles: int, config: dict) -> dict:
+    import ddg
+
+    fingerprint = source_fingerprint()
+    inst = _Instrument()
+    inst.install()
+    try:
+        strip = ddg.Strip.from_ratios(config["width_ratio"], COMPRESSION_RATIO)
+        protocol = ddg.LoadingProtocol(COMPRESSION_RATIO, config["shear_ratio"],
+                                       compression_steps=config["compression_steps"],
+                                       shear_steps=config["shear_steps"])
+        c0, t0 = time.process_time(), time.perf_counter()
+        result = ddg.simulate(strip, protocol, model="plate", resolution=triangles)
+        wall = time.perf_counter() - t0
+        cpu = time.process_time() - c0
+    finally:
+        inst.restore()
+
+    s = result.summary
+    model = result.model
+    rows = result.rows
+    shear_rows = [r for r in rows if r["stage"] == "shear"]
+    its = int(s["newton_iterations"])
+
+    # level-1 split and the sub-split of evaluate
+    split = {c: inst.level1.get(c, 0.0) for c in LEVEL1}
+    split["other"] = wall - sum(split.values())
+    sub = {c: inst.level2.get((c, "evaluate"), 0.0) for c in LEVEL2}
+    sub["evaluate_rest"] = split["evaluate"] - sum(sub.values())
+    outside = {f"{c} outside evaluate": inst.level2[(c, ctx)] for (c, ctx) in inst.level2 if ctx != "evaluate"}
+    per_it = {k: (1e3 * v / its if its else None) for k, v in {**split, **sub}.items()}
+    # linear algebra: factorisation vs solves (outermost calls only)
+    fx = inst.by_function
+    linalg_detail = {
+        "cholesky_s": fx["SymmetricBanded.cholesky"]["top"][1] if "SymmetricBanded.cholesky" in fx else 0.0,
+        "solve_s": fx["SymmetricBanded.solve"]["top"][1] if "SymmetricBanded.solve" in fx else 0.0,
+        "lu_solve_banded_inside_solve_s": fx["scipy.linalg.solve_banded"]["linalg"][1]
+        if "scipy.linalg.solve_banded" in fx else 0.0,
+    }
+    evals = {k: {"calls": v[0], "time_s": v[1], "per_newton_iteration": v[0] / its if its else None,
+                 "ms_per_call": 1e3 * v[1] / v[0] if v[0] else None} for k, v in inst.eval_kinds.items()}
+
+    by_caller = defaultdict(lambda: {"solves": 0, "iterations": 0, "failed": 0, "iterations_failed": 0})
+    for rec in inst.newton_calls:
+        b = by_caller[rec["caller"] + (" (minimize)" if rec["minimize"] else "")]
+        b["solves"] += 1
+        b["iterations"] += rec["iterations"]
+        if not rec["converged"]:
+            b["failed"] += 1
+            b["iterations_failed"] += rec["iterations"]
+    comp_steps = [st for st in inst.steps if st["dW_over_L"] == 0.0]
+    shear_steps = [st for st in inst.steps if st["dW_over_L"] != 0.0]
+    K = model.free_matrix(result.final_state.evaluation.hessian) if result.final_state is not None else None
+    return {
+        "triangles_target": triangles,
+        "ddg_source_sha256": fingerprint,
+        "triangles": int(model.mesh.triangle_count),
+        "nodes": int(model.mesh.node_count),
+        "n_dof": s.get("n_dof"),
+        "n_free_dof": s.get("n_free_dof"),
+        "bandwidth": int(K.band.shape[0] - 1) if K is not None else getattr(model, "bandwidth", None),
+        "wall_time_s": wall,
+        "cpu_time_s": cpu,
+        "library_wall_time_s": s.get("wall_time_s"),
+        "newton_iterations": its,
+        "time_per_newton_iteration_ms": 1e3 * wall / its if its else None,
+        "recorded_steps": len(rows),
+        "recorded_shear_steps": len(shear_rows),
+        "completed": bool(s["converged"]),
+        "message": s.get("message", ""),
+        "dW_over_L_reached": float(rows[-1]["dW_over_L"]) if rows else None,
+        "dW_max_over_L": s.get("dW_max_over_L"),
+        "dW1_over_L": s.get("dW1_over_L"),
+        "dW2_over_L": s.get("dW2_over_L"),
+        "H_mid_over_L_compressed": s.get("H_mid_over_L_compressed"),
+        "split_s": {**split, **sub, **outside},
+        "split_fraction": {k: v / wall for k, v in {**split, **sub}.items()},
+        "split_ms_per_newton_iteration": per_it,
+        "linalg_detail": linalg_detail,
+        "evaluations": evals,
+        "evaluations_total": sum(v[0] for v in inst.eval_kinds.values()),
+        "calls": {
+            "level1": {c: {"calls": inst.level1_calls[c], "time_s": inst.level1[c]} for c in LEVEL1},
+            "by_function": {k: {ctx: {"calls": v[0], "time_s": v[1]} for ctx, v in d.items()} for k, d in fx.items()},
+            "cholesky_factorisations": {ctx: dict(d) for ctx, d in inst.factorisations.items()},
+            "lowest_eigenpairs_paths": {k: {"calls": v[0], "time_s": v[1]} for k, v in inst.eigen_paths.items()},
+        },
+        "newton_by_caller": dict(by_caller),
+        "stage": {
+            name: {"time_s": sum(st["time_s"] for st in group), "iterations": sum(st["iterations_all"] for st in group),
+                   "failed_solves": sum(st["failed_solves"] for st in group)}
+            for name, group in (("compression", comp_steps), ("shear", shear_steps))
+        },
+        "steps": inst.steps,
+        "branch_switches_dW_over_L": [r["dW_over_L"] for r in shear_rows if r.get("branch_switched")],
+        "instrumentation_notes": inst.notes,
+    }
+
+
+def _child(triangles: int, config: dict, conn) -> None:
+    try:
+        conn.send(("ok", _run_once(triangles, config)))
+    except BaseException:  # report any failure to the parent instead of dying silently
+        conn.send(("error", traceback.format_exc()))
+    finally:
+        conn.close()
+
+
+def run_in_child(triangles: int, config: dict, timeout: float | None) -> tuple[str, object, float]:
+    """Run one N in a fresh process; returns (status, payload, elapsed)."""
+    ctx = mp.get_context("spawn")
+    parent, child = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_child, args=(triangles, config, child), daemon=True)
+    t0 = time.perf_counter()
+    proc.start()
+    child.close()
+    try:
+        if parent.poll(timeout):
+            status, payload = parent.recv()
+        else:
+            status, payload = "timeout", f"no result within {timeout:g} s"
+    except EOFError:
+        status, payload = "error", f"child exited with code {proc.exitcode} without a result"
+    elapsed = time.perf_counter() - t0
+    if proc.is_alive():
+        proc.terminate()  # only the child this function started
+    proc.join(5)
+    if proc.is_alive():
+        proc.kill()
+        proc.join()
+    parent.close()
+    return status, payload, elapsed
+
+
+# ---------------------------------------------------------------------------- machine
+def blas_info() -> dict:
+    """The BLAS/LAPACK libraries numpy/scipy were built against (numpy.show_config) and the ones
+    actually loaded in this process (/proc/self/maps: real paths, so Debian's BLAS alternatives show)."""
+    import numpy
+    import scipy.linalg  # noqa: F401  (loads LAPACK)
+
+    buf = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(buf):
+            numpy.show_config()
+    except Exception as exc:  # pragma: no cover
+        buf.write(f"show_config failed: {exc}")
+    built, section = {}, None
+    for line in buf.getvalue().splitlines():
+        if line and not line.startswith(" ") and line.rstrip().endswith(":"):
+            section = line.rstrip()[:-1]
+        elif section and line.strip().startswith("libraries"):
+            built[section] = line.split("=", 1)[1].strip()
+    loaded = set()
+    try:
+        with open("/proc/self/maps") as fh:
+            for line in fh:
+                path = line.split()[-1] if len(line.split()) >= 6 else ""
+                name = os.path.basename(path).lower()
+                if name.startswith("lib") and any(t in name for t in ("blas", "lapack", "mkl", "blis", "atlas")):
+                    loaded.add(path)
+    except OSError:
+        pass
+    return {"numpy_show_config": built, "loaded": sorted(loaded)}
+
+
+def machine_info() -> dict:
+    info = _rod_machine_info()
+    info["blas"] = blas_info()
+    return info
+
+
+# ---------------------------------------------------------------------------- reporting
+RUN_HEADER = ("N target", "triangles", "free DOF", "band", "wall s", "cpu s", "Newton its", "ms/it", "complete",
+              "dW/L reached", "steps", "full evals/it", "grad evals/it", "energy evals/it", "ms/full eval")
+SPLIT_HEADER = ("triangles", "eval ms/it", "kernels", "assembly", "eval rest", "factor+solve ms/it",
+                "eigen ms/it", "other ms/it", "eval %", "kernels %", "assembly %", "linalg %", "eig %", "other %")
+
+
+def _run_rows(results: list[dict]) -> list[tuple]:
+    out = []
+    for r in results:
+        if r["status"] != "ok":
+            out.append((str(r["triangles_target"]), "", r["status"]) + ("",) * (len(RUN_HEADER) - 3))
+            continue
+        ev = r["evaluations"]
+
+        def per_it(kind):
+            v = ev.get(kind, {}).get("per_newton_iteration")
+            return f"{v:.2f}" if v is not None else "0"
+
+        full_ms = ev.get("full", {}).get("ms_per_call")
+        out.append((
+            str(r["triangles_target"]), str(r["triangles"]), str(r["n_free_dof"]), str(r["bandwidth"]),
+            f"{r['wall_time_s']:.2f}", f"{r['cpu_time_s']:.2f}", str(r["newton_iterations"]),
+            _fmt(r["time_per_newton_iteration_ms"], ".2f"), "yes" if r["completed"] else "NO",
+            _fmt(r["dW_over_L_reached"], ".4f") + (f" / {r['dW_max_over_L']:.4f}" if r.get("dW_max_over_L") else ""),
+            str(r["recorded_steps"]), per_it("full"), per_it("gradient"), per_it("energy"), _fmt(full_ms, ".2f"),
+        ))
+    return out
+
+
+def _split_rows(results: list[dict]) -> list[tuple]:
+    out = []
+    for r in results:
+        if r["status"] != "ok":
+            continue
+        p, f = r["split_ms_per_newton_iteration"], r["split_fraction"]
+        out.append((
+            str(r["triangles"]), _fmt(p["evaluate"], ".2f"), _fmt(p["kernels"], ".2f"), _fmt(p["assembly"], ".2f"),
+            _fmt(p["evaluate_rest"], ".2f"), _fmt(p["linalg"], ".2f"), _fmt(p["eigen"], ".2f"), _fmt(p["other"], ".2f"),
+            f"{100 * f['evaluate']:.0f}", f"{100 * f['kernels']:.0f}", f"{100 * f['assembly']:.0f}",
+            f"{100 * f['linalg']:.0f}", f"{100 * f['eigen']:.0f}", f"{100 * f['other']:.0f}",
+        ))
+    return out
+
+
+def text_table(header, rows) -> str:
+    rows = [header] + rows
+    widths = [max(len(row[i]) for row in rows) for i in range(len(header))]
+    lines = ["  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in rows]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def markdown_table(header, rows) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---:" for _ in header) + "|"]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def _slope(xs, ys):
+    """fit_slope, or None with fewer than two distinct x (targets that round to the same mesh)."""
+    return fit_slope(xs, ys) if len(set(xs)) >= 2 else None
+
+
+def scaling(results: list[dict]) -> dict:
+    ok = [r for r in results if r["status"] == "ok" and r["completed"]]
+    ts = [r["triangles"] for r in ok]
+    return {
+        "triangles_fitted": ts,
+        "wall_time_slope": _slope(ts, [r["wall_time_s"] for r in ok]),
+        "newton_iterations_slope": _slope(ts, [r["newton_iterations"] for r in ok]),
+        "time_per_iteration_slope": _slope(ts, [r["time_per_newton_iteration_ms"] for r in ok]),
+        "category_slopes": {c: _slope(ts, [max(r["split_s"][c], 1e-12) for r in ok])
+                            for c in (*LEVEL1, *LEVEL2, "other")},
+    }
+
+
+def observations(results: list[dict]) -> list[str]:
+    notes = []
+    for r in results:
+        if r["status"] != "ok":
+            notes.append(f"N = {r['triangles_target']}: {r['status']} ({r.get('error', '')})".strip())
+            continue
+        st = r["stage"]
+        nb = r["newton_by_caller"]
+        steps = sorted(r["steps"], key=lambda s: -s["iterations_all"])[:3]
+        worst = ", ".join(f"dL/L={s['dL_over_L']:.3f} dW/L={s['dW_over_L']:.4f}: {s['iterations_all']} its, "
+                          f"{s['time_s']:.2f} s ({s['newton_solves']} solves, {s['failed_solves']} failed)" for s in steps)
+        failed = sum(b["iterations_failed"] for b in nb.values())
+        caller = ", ".join(f"{k} {v['solves']} solves/{v['iterations']} its" for k, v in sorted(nb.items()))
+        fac = r["calls"]["cholesky_factorisations"]
+        fac_txt = "; ".join(f"{ctx}: " + ", ".join(f"{n} {k}" for k, n in d.items()) for ctx, d in fac.items())
+        ld = r["linalg_detail"]
+        notes.append(
+            f"N = {r['triangles_target']} ({r['triangles']} triangles): {r['message']!r}. Compression "
+            f"{st['compression']['iterations']} its / {st['compression']['time_s']:.2f} s, shear "
+            f"{st['shear']['iterations']} its / {st['shear']['time_s']:.2f} s; iterations in failed Newton solves "
+            f"{failed}; by caller: {caller}; most expensive recorded steps: {worst or 'none'}; branch switches at dW/L = "
+            f"{', '.join(f'{x:.4f}' for x in r['branch_switches_dW_over_L']) or 'none'}. Linear algebra: Cholesky "
+            f"{ld['cholesky_s']:.2f} s, solves {ld['solve_s']:.2f} s (of which banded LU on indefinite matrices "
+            f"{ld['lu_solve_banded_inside_solve_s']:.2f} s); Cholesky factorisations by context: {fac_txt or 'none'}. "
+            "Eigenvalue calls: " + ("; ".join(f"{k} {v['calls']} calls/{v['time_s']:.2f} s"
+                                              for k, v in r["calls"]["lowest_eigenpairs_paths"].items()) or "none")
+            + "." + (f" Instrumentation notes: {'; '.join(r['instrumentation_notes'])}." if r["instrumentation_notes"] else "")
+        )
+    return notes
+
+
+def markdown_report(report: dict) -> str:
+    sc, mi, scene = report["scaling"], report["machine"], report["scene"]
+    results = report["results"]
+    lines = [
+        "# Plate solver, full path: speed",
+        "",
+        f"Scene: W/L = {scene['width_ratio']:.6g}, dL/L = {COMPRESSION_RATIO} in {scene['compression_steps']} recorded "
+        f"steps, then shear to dW/L = {scene['shear_ratio']} in {scene['shear_steps']} recorded steps, model "
+        f"\"plate\" on the structured mesh with about N triangles (`python -m benchmarks.plate_path`). Wall time is "
+        f"the best of {report['repeat']} run(s) per N, each in a fresh process.",
+        "",
+        "## Runs",
+        "",
+        markdown_table(RUN_HEADER, _run_rows(results)),
+        "",
+        "triangles = `result.model.mesh.triangle_count`; free DOF = `summary['n_free_dof']`; band = bandwidth of the "
+        "free-DOF Hessian (lower band storage rows - 1); cpu s = CPU time of the child process during the run (above "
+        "the wall time when BLAS uses a second thread, below it when the process waited for a core); Newton its = "
+        "`summary['newton_iterations']` (including failed and branch-switching solves); complete = the path reached "
+        "its last load (the message is below); dW/L reached = the last recorded row / the largest asked. Evaluations "
+        "per Newton iteration: full = energy + gradient + Hessian (one per accepted step and one at the start of "
+        "each solve), grad = energy + gradient (line-search trials on indefinite Hessians), energy = energy only "
+        "(line-search trials after a rejected full step).",
+        "",
+        "## Time per Newton iteration",
+        "",
+        markdown_table(SPLIT_HEADER, _split_rows(results)),
+        "",
+        "Milliseconds per Newton iteration (category time / Newton iterations; the evaluations, factorisations and "
+        "eigen-solves outside the iterations proper are spread over them) and share of the wall time:",
+        "",
+    ]
+    lines += [f"- {CATEGORY_LABELS[k]}" for k in ("evaluate", "kernels", "assembly", "evaluate_rest", "linalg",
+                                                  "eigen", "other")]
+    lines += [
+        "",
+        "Method: the functions named above are wrapped with `time.perf_counter` timers at run time in the child "
+        "process (the library is not modified; the wrappers are removed afterwards). A call nested inside another "
+        "timed call is counted once, for the outermost one: the factorisations and Lanczos solves inside "
+        "`lowest_eigenpairs` are eigenvalue work, not (b); kernels and assembly are counted inside (a). Per-function "
+        "inclusive times by enclosing category are in the JSON (`calls.by_function`).",
+        "",
+        f"- growth exponent d log(wall time) / d log(triangles) over {sc['triangles_fitted']}: "
+        f"**{_fmt(sc['wall_time_slope'], '.2f')}** (Newton iterations: {_fmt(sc['newton_iterations_slope'], '.2f')}, "
+        f"time per iteration: {_fmt(sc['time_per_iteration_slope'], '.2f')}); per category: "
+        + ", ".join(f"{k} {_fmt(v, '.2f')}" for k, v in sc["category_slopes"].items()),
+        f"- load average (1 min) before / after the runs: {report['load_average'][0]} / {report['load_average'][1]} "
+        "(other processes on the machine inflate wall times)",
+        "",
+        "## Per run",
+        "",
+    ]
+    lines += [f"- {n}" for n in report["observations"]]
+    blas = mi.get("blas", {})
+    lines += [
+        "",
+        "## Machine",
+        "",
+        f"{mi['cpu_count']} CPUs ({mi['cpu_model']}), {mi['platform']}, Python {mi['python']}, numpy {mi['numpy']}, "
+        f"scipy {mi['scipy']}, ddg {mi['ddg']}; {mi['date']}. BLAS/LAPACK loaded: "
+        + ("; ".join(f"`{x}`" for x in blas.get("loaded", [])) or "unknown")
+        + f". Thread settings: {mi['thread_env']}. ddg sources sha256 `{report['ddg_source_sha256'][:16]}`"
+        + (" (CHANGED during the run: runs may mix library versions)" if report["ddg_source_changed_during_run"] else "")
+        + ".",
+        "",
+    ]
+    return "\n".join(lines)
+
+
+def ratio(text: str) -> float:
+    """A ratio given as a decimal or a fraction: 0.1667 or 1/6."""
+    try:
+        return float(Fraction(text))
+    except (ValueError, ZeroDivisionError):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number or fraction") from None
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.plate_path", description=__doc__.split("\n")[0])
+    parser.add_argument("--triangles", type=int, nargs="+", default=TRIANGLES, help="target triangle counts N")
+    parser.add_argument("--width-ratio", type=ratio, default=WIDTH_RATIO, help="W/L (decimal or fraction; default 1/6)")
+    parser.add_argument("--compression-steps", type=int, default=COMPRESSION_STEPS)
+    parser.add_argument("--shear-steps", type=int, default=SHEAR_STEPS)
+    parser.add_argument("--shear-ratio", type=ratio, default=None,
+                        help="largest dW/L (default dW_max/L); a small value gives a short smoke run")
+    parser.add_argument("--repeat", type=int, default=1, help="runs per N; the best wall time is reported")
+    parser.add_argument("--out", default="benchmarks/results", help="directory for plate_path.json and plate_path.md")
+    parser.add_argument("--timeout", type=float, default=1800.0,
+                        help="seconds allowed for one run of one N (0: no limit); a run over it is stopped and reported")
+    args = parser.parse_args(argv)
+    if args.repeat < 1 or any(t < 16 for t in args.triangles) or args.shear_steps < 1 or args.compression_steps < 1:
+        parser.error("--repeat, --shear-steps, --compression-steps must be >= 1 and every N >= 16")
+    timeout = args.timeout if args.timeout > 0 else None
+    config = {"width_ratio": args.width_ratio, "shear_ratio": args.shear_ratio,
+              "compression_steps": args.compression_steps, "shear_steps": args.shear_steps}
+
+    fingerprint_start = source_fingerprint()
+    load_start = _load()
+    results = []
+    for n in args.triangles:
+        best, attempts = None, []
+        for k in range(args.repeat):
+            status, payload, elapsed = run_in_child(n, config, timeout)
+            if status == "ok":
+                attempts.append(payload["wall_time_s"])
+                if best is None or payload["wall_time_s"] < best["wall_time_s"]:
+                    best = payload
+                print(f"N = {n} run {k + 1}/{args.repeat}: {payload['triangles']} triangles, "
+                      f"{payload['wall_time_s']:.2f} s, {payload['newton_iterations']} Newton its, "
+                      f"complete {payload['completed']}", file=sys.stderr)
+            else:
+                print(f"N = {n} run {k + 1}/{args.repeat}: {status} after {elapsed:.0f} s", file=sys.stderr)
+                if best is None:
+                    best = {"triangles_target": n, "status": status, "error": payload if status == "error" else
+                            f"stopped after {elapsed:.0f} s (--timeout {args.timeout:g})"}
+                    if status == "error":
+                        print(payload, file=sys.stderr)
+                break  # a timeout or crash will repeat; do not wait again
+        if "status" not in best:
+            best["status"] = "ok"
+            best["all_wall_times_s"] = attempts
+        results.append(best)
+
+    report = {
+        "benchmark": "plate_path",
+        "scene": {"width_ratio": args.width_ratio, "compression_ratio": COMPRESSION_RATIO,
+                  "compression_steps": args.compression_steps, "shear_steps": args.shear_steps,
+                  "shear_ratio": "dW_max/L" if args.shear_ratio is None else args.shear_ratio, "model": "plate"},
+        "repeat": args.repeat,
+        "timeout_s": timeout,
+        "split_categories": CATEGORY_LABELS,
+        "method": "run-time timer wrappers; nested timed calls counted once, by the outermost (see module docstring)",
+        "results": results,
+        "scaling": scaling(results),
+        "machine": machine_info(),
+        "ddg_source_sha256": fingerprint_start,
+        "load_average": [load_start, _load()],
+        "ddg_source_changed_during_run": source_fingerprint() != fingerprint_start or any(
+            r.get("ddg_source_sha256", fingerprint_start) != fingerprint_start for r in results),
+    }
+    report["observations"] = observations(results)
+
+    out = Path(args.out)
+    atomic_write_text(out / "plate_path.json", json.dumps(report, indent=1, default=float) + "\n")
+    atomic_write_text(out / "plate_path.md", markdown_report(report))
+
+    sc = report["scaling"]
+    if report["ddg_source_changed_during_run"]:
+        print("WARNING: the ddg sources changed while the benchmark ran; the runs may mix library versions",
+              file=sys.stderr)
+    print(text_table(RUN_HEADER, _run_rows(results)))
+    print()
+    print(text_table(SPLIT_HEADER, _split_rows(results)))
+    print()
+    print(f"growth exponent d log(time)/d log(triangles) over {sc['triangles_fitted']}: "
+          f"{_fmt(sc['wall_time_slope'], '.2f')} (Newton iterations {_fmt(sc['newton_iterations_slope'], '.2f')}, "
+          f"time/iteration {_fmt(sc['time_per_iteration_slope'], '.2f')})")
+    for n in report["observations"]:
+        print("-", n)
+    print(f"wrote {out / 'plate_path.json'} and {out / 'plate_path.md'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -92,3 +92,51 @@ def test_dynamic_solver_writes_the_same_contract(tmp_path):
     assert header[: len(CONTRACT_COLUMNS)] == CONTRACT_COLUMNS
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert CONTRACT_KEYS <= set(summary) and summary["solver"] == "implicit-euler" and summary["converged"]
+
+
+PLATE_RUN = ["simulate", "--model", "plate", "--width-ratio", "0.1667", "--compression-ratio", "0.5",
+             "--shear-ratio", "0.05", "--resolution", "200", "--compression-steps", "4", "--shear-steps", "2", "--quiet"]
+
+
+def test_plate_run_writes_the_same_contract_and_frames(tmp_path):
+    pytest.importorskip("meshio")
+    assert main(PLATE_RUN + ["--frames", "--out", str(tmp_path)]) == 0
+    with open(tmp_path / "path.csv") as fh:
+        rows = list(csv.reader(fh))
+    assert rows[0][: len(CONTRACT_COLUMNS)] == CONTRACT_COLUMNS and len(rows) == 1 + 1 + 4 + 2
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert CONTRACT_KEYS <= set(summary) and summary["model"] == "plate"
+    assert summary["mesh"]["triangles"] > 0 and summary["n_dof"] == 3 * summary["mesh"]["nodes"]
+    frames = sorted((tmp_path / "frames").glob("frame_*.vtu"))
+    assert len(frames) == 7 and (tmp_path / "frames" / "frames.pvd").is_file()
+    with open(tmp_path / "centerline.csv") as fh:
+        centerline = list(csv.DictReader(fh))
+    assert len(centerline) == 7 * 101
+    last = [r for r in centerline if r["row"] == "6"]
+    assert float(last[0]["x_over_L"]) == pytest.approx(0.0, abs=1e-12)  # the fixed clamp point
+    assert float(last[-1]["y_over_L"]) == pytest.approx(0.05, abs=1e-12)  # the moving one, sheared
+
+
+def test_plate_reads_a_mesh_file(tmp_path):
+    meshio = pytest.importorskip("meshio")
+    from ddg.geometry.plate_mesh import structured_mesh
+
+    L, W = 150e-3, 0.1667 * 150e-3
+    mesh = structured_mesh(L, W, 200)
+    points = mesh.nodes + [3.0, 1.0]  # any offset: read_mesh moves the clamp lines to x = 0 and L
+    meshio.write(tmp_path / "strip.msh", meshio.Mesh(points, [("triangle", mesh.triangles)]), file_format="gmsh22")
+    assert main(PLATE_RUN + ["--mesh", str(tmp_path / "strip.msh"), "--out", str(tmp_path / "out")]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["mesh"]["triangles"] == mesh.triangle_count
+
+
+def test_plate_mesh_of_the_wrong_width_is_a_one_line_error(tmp_path, capsys):
+    meshio = pytest.importorskip("meshio")
+    from ddg.geometry.plate_mesh import structured_mesh
+
+    mesh = structured_mesh(150e-3, 10e-3, 200)
+    meshio.write(tmp_path / "narrow.msh", meshio.Mesh(mesh.nodes, [("triangle", mesh.triangles)]), file_format="gmsh22")
+    capsys.readouterr()  # meshio's own warnings while writing the test file
+    assert main(PLATE_RUN + ["--mesh", str(tmp_path / "narrow.msh"), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "width" in err

@@ -12,7 +12,7 @@ import scipy
 
 from .geometry.strip import InputError, LoadingProtocol, Strip
 from .io import write_centerline_csv, write_path_csv, write_summary_json
-from .observables import observe
+from .observables import observe, resolved_up_to
 from .solve.continuation import ContinuationFailure, ContinuationOptions, PathFollower
 
 DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000}
@@ -238,6 +238,7 @@ def simulate(
         summary["newton_iterations"] = follower.newton_iterations
         summary["wall_time_s"] = time.perf_counter() - t0
         summary["recorded_steps"] = len(rows)
+        summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
         if writer is not None:
             writer.close()
         result = SimulationResult(rows, summary, state, instance, centerlines)

@@ -140,3 +140,23 @@ def test_wide_plate_leaves_the_U_branch_well_before_the_narrow_one():
     assert 0.10 < wide < 0.20, wide
     assert 0.31 < narrow < 0.39, narrow
     assert narrow - wide > 0.1
+
+
+def test_resolution_indicators_of_the_compressed_plate():
+    """The U of dL/L = 1/2 turns by at most kappa_max h between neighbouring triangles
+    (kappa_max L ~ 2 pi x 1.3 for the clamped elastica) and stretches by round-off only."""
+    result = compress(1 / 6, 1000)
+    row = result.rows[-1]
+    spacing = 2.0 * result.model.mesh.clamp_depth / result.model.strip.length
+    assert 0.0 < row["max_turn_angle_deg"] < np.degrees(2 * np.pi * 1.5 * spacing)
+    assert row["max_strain"] < 1e-4
+    assert result.summary["resolved_up_to_dW_over_L"] is None  # no shear recorded
+
+
+def test_resolved_up_to_stops_at_the_first_unresolved_shear_row():
+    from ddg.observables import RESOLVED_TURN_ANGLE_DEG, resolved_up_to
+
+    rows = [{"stage": "compression", "dW_over_L": 0.0, "max_turn_angle_deg": 50.0}]
+    rows += [{"stage": "shear", "dW_over_L": 0.1 * k, "max_turn_angle_deg": a}
+             for k, a in enumerate([5.0, 10.0, RESOLVED_TURN_ANGLE_DEG + 1.0, 5.0])]
+    assert resolved_up_to(rows) == pytest.approx(0.1)

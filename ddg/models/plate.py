@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from ..energies.hinge_bending import hinge_bending_energy, hinge_stiffness
+from ..energies.hinge_bending import hinge_bending_energy, hinge_stiffness, triangle_normals
 from ..energies.stretch import stretching_energy, two_node_blocks
 from ..geometry.centerline import first_mode_profile
 from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, structured_mesh
@@ -138,6 +138,17 @@ class PlateModel(BandedModel):
         s = np.linspace(0.0, self.strip.length, stations)
         where = self.mesh.interpolation_matrix(np.stack([s, np.zeros_like(s)], axis=1))
         return self._interpolate(q, where), s
+
+    def resolution_indicators(self, q: np.ndarray) -> dict:
+        """Largest angle between neighbouring triangle normals (degrees) and largest edge strain."""
+        mesh = self.mesh
+        x = q[self.node_dofs]
+        normals, _ = triangle_normals(x, mesh.triangles)
+        ht = mesh.hinge_triangles
+        cosine = np.clip(np.einsum("hi,hi->h", normals[ht[:, 0]], normals[ht[:, 1]]), -1.0, 1.0)
+        lengths = np.linalg.norm(x[mesh.edges[:, 1]] - x[mesh.edges[:, 0]], axis=1)
+        return {"max_turn_angle_deg": float(np.degrees(np.arccos(cosine.min()))),
+                "max_strain": float(np.max(np.abs(lengths / self.rest_edge_lengths - 1.0)))}
 
     # ------------------------------------------------------------------ energy
     def evaluate(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:

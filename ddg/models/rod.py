@@ -116,6 +116,16 @@ class RodModel(BandedModel):
         sn = self.centerline.node_arclength
         return np.stack([np.interp(s, sn, x[:, k]) for k in range(3)], axis=1), s
 
+    def resolution_indicators(self, q: np.ndarray) -> dict:
+        """Largest turning angle between neighbouring edges (degrees) and largest edge strain."""
+        x = q[self.node_dofs]
+        edges = x[1:] - x[:-1]
+        lengths = np.linalg.norm(edges, axis=1)
+        t = edges / lengths[:, None]
+        cosine = np.clip(np.einsum("ij,ij->i", t[:-1], t[1:]), -1.0, 1.0)
+        return {"max_turn_angle_deg": float(np.degrees(np.arccos(cosine.min()))),
+                "max_strain": float(np.max(np.abs(lengths / self.rest_edge_lengths - 1.0)))}
+
     def mode_sign(self, mode: np.ndarray, direction: int) -> float:
         """Sign convention of a mode: +1 raises the midpoint (direction=1) or the first half
         of the strip against the second (direction=0, the '+' branches US+ and S+)."""

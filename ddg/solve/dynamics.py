@@ -30,7 +30,7 @@ import numpy as np
 
 from ..api import SimulationResult, base_summary
 from ..geometry.strip import InputError, LoadingProtocol, Strip
-from ..observables import observe
+from ..observables import observe, resolved_up_to
 from .banded import SymmetricBanded
 from .continuation import ContinuationFailure, ContinuationOptions, PathFollower, State
 from .newton import NewtonOptions, newton, scaled_residual
@@ -337,6 +337,7 @@ def simulate_dynamic(
         summary["newton_iterations"] = integrator.newton_iterations if integrator is not None else start_iterations
         summary["wall_time_s"] = time.perf_counter() - t0
         summary["recorded_steps"] = len(rows)
+        summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
         result = DynamicResult(rows, summary, state, model, trace=trace)
         if out is not None:
             result.write(out)

@@ -143,12 +143,14 @@ def test_wide_plate_leaves_the_U_branch_well_before_the_narrow_one():
 
 
 def test_resolution_indicators_of_the_compressed_plate():
-    """The U of dL/L = 1/2 turns by at most kappa_max h between neighbouring triangles
-    (kappa_max L ~ 2 pi x 1.3 for the clamped elastica) and stretches by round-off only."""
+    """Neighbouring triangles of the U of dL/L = 1/2 turn by kappa_max h_x at most: the normals
+    of the two column strips either side of an edge along y sit at their chord midpoints, one
+    column spacing h_x apart. kappa_max L = 9.94 for this clamped elastica (the rod at M = 200:
+    largest turning angle / h). Stretching is negligible."""
     result = compress(1 / 6, 1000)
     row = result.rows[-1]
     spacing = 2.0 * result.model.mesh.clamp_depth / result.model.strip.length
-    assert 0.0 < row["max_turn_angle_deg"] < np.degrees(2 * np.pi * 1.5 * spacing)
+    assert row["max_turn_angle_deg"] == pytest.approx(np.degrees(9.94 * spacing), rel=0.05)
     assert row["max_strain"] < 1e-4
     assert result.summary["resolved_up_to_dW_over_L"] is None  # no shear recorded
 

@@ -119,8 +119,9 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
             alpha *= 0.5
         if not accepted:
             return NewtonResult(q, ev, False, iteration + 1, res, pd, "line search failed")
+        if iteration == 0:
+            first_residual = res
         if not minimize:
-            first_residual = res if iteration == 0 else first_residual
             if options.give_up_after is not None and iteration >= options.give_up_after \
                     and res > options.give_up_ratio * first_residual:
                 return NewtonResult(q, ev, False, iteration + 1, res, pd,

@@ -37,22 +37,21 @@ and OUT/plate_linear_algebra.md atomically. Not part of the test run.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import gc
-import json
 import math
 import statistics
 import sys
 import time
 import traceback
-from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from benchmarks.plate_path import _load, machine_info, ratio, source_fingerprint
-from ddg.io import atomic_write_text
+from benchmarks.common import (Provenance, machine_section, ratio, section, table_section, text_table,
+                               write_report)
 
 TRIANGLES = [500, 1000, 2000, 4000]
 WIDTH_RATIOS = ["1/20", "1/6", "1/2"]
@@ -81,22 +80,33 @@ def cholmod_module():
 
 
 # ---------------------------------------------------------------------------- timing
+@contextlib.contextmanager
+def _gc_paused():
+    """The garbage collector off (and back on if it was) around the timed calls."""
+    gc_was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if gc_was:
+            gc.enable()
+
+
+def _stats(times: list[float], repeat: int) -> dict:
+    return {"median_ms": 1e3 * statistics.median(times), "min_ms": 1e3 * min(times), "repeats": repeat}
+
+
 def timed(fn, repeat: int, setup=None) -> tuple[dict, object]:
     """Median/min wall time of fn(setup()) over `repeat` calls after one warm-up; setup is untimed."""
     out = fn(setup() if setup else None)  # warm-up (imports, caches, page faults)
     times = []
-    gc_was = gc.isenabled()
-    gc.disable()
-    try:
+    with _gc_paused():
         for _ in range(repeat):
             arg = setup() if setup else None
             t0 = time.perf_counter()
             out = fn(arg)
             times.append(time.perf_counter() - t0)
-    finally:
-        if gc_was:
-            gc.enable()
-    return {"median_ms": 1e3 * statistics.median(times), "min_ms": 1e3 * min(times), "repeats": repeat}, out
+    return _stats(times, repeat), out
 
 
 def timed_pair(factor, solve, repeat: int) -> tuple[dict, dict, object, object]:
@@ -105,9 +115,7 @@ def timed_pair(factor, solve, repeat: int) -> tuple[dict, dict, object, object]:
     f = factor()
     x = solve(f)  # warm-up
     tf, ts = [], []
-    gc_was = gc.isenabled()
-    gc.disable()
-    try:
+    with _gc_paused():
         for _ in range(repeat):
             t0 = time.perf_counter()
             f = factor()
@@ -116,12 +124,8 @@ def timed_pair(factor, solve, repeat: int) -> tuple[dict, dict, object, object]:
             t2 = time.perf_counter()
             tf.append(t1 - t0)
             ts.append(t2 - t1)
-    finally:
-        if gc_was:
-            gc.enable()
     both = [a + b for a, b in zip(tf, ts)]
-    stat = lambda v: {"median_ms": 1e3 * statistics.median(v), "min_ms": 1e3 * min(v), "repeats": repeat}
-    return stat(tf), stat(ts), stat(both), (f, x)
+    return _stats(tf, repeat), _stats(ts, repeat), _stats(both, repeat), (f, x)
 
 
 # ---------------------------------------------------------------------------- matrices
@@ -406,7 +410,6 @@ def conclusion(cases: list[dict]) -> list[str]:
 
 
 def markdown_report(report: dict) -> str:
-    mi = report["machine"]
     cases = report["cases"]
     lines = [
         "# Plate linear algebra: factorisations, eigen-solve and element work on one Hessian",
@@ -417,17 +420,10 @@ def markdown_report(report: dict) -> str:
         "the band (band[d, j] = A[j + d, j]) to CSC for the sparse solvers "
         "(`python -m benchmarks.plate_linear_algebra`). Times in ms, median of "
         f"{report['repeat']} calls after one warm-up.",
-        "",
-        "## Conclusion",
-        "",
     ]
-    lines += [f"- {x}" for x in report["conclusion"]]
-    lines += [
-        "",
-        "## Factorisations (ms)",
-        "",
-        markdown_table(FACTOR_HEADER, factor_rows(cases)),
-        "",
+    lines += section("Conclusion", report["conclusion"])
+    lines += table_section(
+        "Factorisations (ms)", FACTOR_HEADER, factor_rows(cases),
         "n = free DOFs; band = bandwidth (largest d with a nonzero band[d]); nnz = nonzeros of the full symmetric "
         "matrix; PD = the banded Cholesky succeeds. chol = `scipy.linalg.cholesky_banded(band, lower=True, "
         "check_finite=False)` (as SymmetricBanded.cholesky); chol+solve adds one `cho_solve_banded`; LU f+s = "
@@ -435,23 +431,17 @@ def markdown_report(report: dict) -> str:
         "timed separately in the JSON); SuperLU columns = `splu` factor only (COLAMD = default; MMD = "
         "permc_spec='MMD_AT_PLUS_A'; MMD sym = the same with diag_pivot_thresh=0 and SymmetricMode; natural = "
         "permc_spec='NATURAL', the band order). fastest factor / x next: the fastest factor-only method "
-        "(banded LU excluded, it has no factor-only time) and the next one's time over it.",
-        "",
-        "## Element work and eigen-solve (ms)",
-        "",
-        markdown_table(ELEMENT_HEADER, element_rows(cases)),
-        "",
+        "(banded LU excluded, it has no factor-only time) and the next one's time over it.")
+    lines += table_section(
+        "Element work and eigen-solve (ms)", ELEMENT_HEADER, element_rows(cases),
         "evaluate full = `PlateModel.evaluate(q)` (energy, gradient, Hessian kernels and band assembly); energy+grad "
         "= `evaluate(q, hessian=False)`; energy only = `evaluate(q, gradient=False, hessian=False)`; assembly = "
         "`BandAssembler.assemble` alone on that state's element blocks; restrict = the free-DOF block "
         "(`SymmetricBanded.restrict`). eigsh sigma=0 = `scipy.sparse.linalg.eigsh(A, k=1, sigma=0, tol=1e-12)` "
         "(shift-invert with its own SuperLU factorisation); lowest_eigenpairs = the project's "
         "`SymmetricBanded.lowest_eigenpairs(1)` on a fresh matrix (its banded Cholesky included) and with the factor "
-        "already computed. eval/chol and assembly/chol: their time over the banded Cholesky factorisation.",
-        "",
-        "## Notes",
-        "",
-    ]
+        "already computed. eval/chol and assembly/chol: their time over the banded Cholesky factorisation.")
+    lines += section("Notes")
     for c in cases:
         st = c["state"]
         extra = "; ".join(f"{k}: {v}" for k, v in c.get("notes", {}).items() if k != "CHOLMOD")
@@ -468,33 +458,8 @@ def markdown_report(report: dict) -> str:
                + f" (banded Cholesky stores {c['band_entries']})" if c.get("factorisations") else "")
             + (f"; {extra}" if extra else "") + (f"; {c['error']}" if c.get("error") else "") + ".")
     lines += [f"- CHOLMOD: {report['cholmod']}"]
-    blas = mi.get("blas", {})
-    lines += [
-        "",
-        "## Machine",
-        "",
-        f"{mi['cpu_count']} CPUs ({mi['cpu_model']}), {mi['platform']}, Python {mi['python']}, numpy {mi['numpy']}, "
-        f"scipy {mi['scipy']}, ddg {mi['ddg']}; {mi['date']}. BLAS/LAPACK loaded: "
-        + ("; ".join(f"`{x}`" for x in blas.get("loaded", [])) or "unknown")
-        + f". Thread settings: {mi['thread_env']}. Load average (1 min) before / after: {report['load_average'][0]} / "
-        f"{report['load_average'][1]}. ddg sources sha256 `{report['ddg_source_sha256'][:16]}`"
-        + (" (CHANGED during the run)" if report["ddg_source_changed_during_run"] else "") + ".",
-        "",
-    ]
-    return "\n".join(lines)
-
-
-def markdown_table(header, rows) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---:" for _ in header) + "|"]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(lines)
-
-
-def text_table(header, rows) -> str:
-    rows = [tuple(header)] + rows
-    widths = [max(len(row[i]) for row in rows) for i in range(len(header))]
-    lines = ["  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in rows]
-    lines.insert(1, "  ".join("-" * w for w in widths))
+    lines += machine_section(report, extra=f" Load average (1 min) before / after: {report['load_average'][0]} / "
+                                           f"{report['load_average'][1]}.", changed_note=" (CHANGED during the run)")
     return "\n".join(lines)
 
 
@@ -515,8 +480,7 @@ def main(argv=None) -> int:
     if args.repeat < 1 or any(t < 16 for t in args.triangles) or args.compression_steps < 1:
         parser.error("--repeat and --compression-steps must be >= 1 and every N >= 16")
 
-    fingerprint = source_fingerprint()
-    load_start = _load()
+    provenance = Provenance()
     cases = []
     for w, label in widths:
         for n in args.triangles:
@@ -539,23 +503,17 @@ def main(argv=None) -> int:
         "cases": cases,
         "conclusion": conclusion(cases),
         "cholmod": cholmod_module()[1] or "available (sksparse.cholmod)",
-        "machine": machine_info(),
-        "ddg_source_sha256": fingerprint,
-        "load_average": [load_start, _load()],
-        "ddg_source_changed_during_run": source_fingerprint() != fingerprint,
+        **provenance.report(blas=True),
     }
-    out = Path(args.out)
-    atomic_write_text(out / "plate_linear_algebra.json",
-                      json.dumps(report, indent=1, default=lambda x: None if isinstance(x, float) and not math.isfinite(x)
-                                 else float(x)) + "\n")
-    atomic_write_text(out / "plate_linear_algebra.md", markdown_report(report))
+    wrote = write_report(args.out, "plate_linear_algebra", report, markdown_report(report),
+                         json_default=lambda x: None if isinstance(x, float) and not math.isfinite(x) else float(x))
     print(text_table(FACTOR_HEADER, factor_rows(cases)))
     print()
     print(text_table(ELEMENT_HEADER, element_rows(cases)))
     print()
     for line in report["conclusion"]:
         print(line)
-    print(f"wrote {out / 'plate_linear_algebra.json'} and {out / 'plate_linear_algebra.md'}")
+    print(wrote)
     return 0
 
 

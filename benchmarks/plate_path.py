@@ -44,23 +44,17 @@ Writes OUT/plate_path.json (all numbers, per-step detail and machine info) and O
 from __future__ import annotations
 
 import argparse
-import contextlib
 import functools
+import importlib
 import inspect
-import io
-import json
-import math
-import multiprocessing as mp
-import os
 import sys
 import time
-import traceback
 from collections import defaultdict
-from fractions import Fraction
-from pathlib import Path
 
-from benchmarks.rod_path import _fmt, _load, fit_slope, machine_info as _rod_machine_info, source_fingerprint
-from ddg.io import atomic_write_text
+from benchmarks.common import (PathInstrument, Provenance, best_of, eigen_paths_text, finish_path_report, fit_slope,
+                               fmt, load_line, machine_section, newton_by_caller, newton_notes, path_slopes,
+                               path_timing, ratio, run_in_child, run_notes, section, slopes_markdown, slopes_text,
+                               source_fingerprint, stage_summary, table_section, text_table, timed_simulate)
 
 WIDTH_RATIO = 1.0 / 6.0
 COMPRESSION_RATIO = 0.5
@@ -86,10 +80,11 @@ CATEGORY_LABELS = {
 
 
 # ---------------------------------------------------------------------------- instrumentation
-class _Instrument:
-    """Timing wrappers on library functions, installed and removed around one run."""
+class _Instrument(PathInstrument):
+    """Timing wrappers on the plate's library functions, installed and removed around one run."""
 
     def __init__(self):
+        super().__init__()
         self.stack: list[tuple[str, str]] = []             # (key, category) of the timed calls in progress
         self.level1 = defaultdict(float)                    # category -> time of outermost level-1 calls
         self.level1_calls = defaultdict(int)
@@ -99,10 +94,6 @@ class _Instrument:
         self.eval_kinds = defaultdict(lambda: [0, 0.0])     # "full" / "gradient" / "energy" -> [calls, s]
         self.factorisations = defaultdict(lambda: defaultdict(int))  # context -> "ok"/"not PD" -> count
         self.eigen_paths = defaultdict(lambda: [0, 0.0])
-        self.newton_calls: list[dict] = []
-        self.steps: list[dict] = []
-        self._current_step: dict | None = None
-        self._patches: list[tuple[object, str, object]] = []
         self.notes: list[str] = []
 
     # -- the timer
@@ -139,11 +130,6 @@ class _Instrument:
         wrapper.__wrapped_by_benchmark__ = True
         return wrapper
 
-    def _set(self, owner, name: str, replacement) -> None:
-        self._patches.append((owner, name, getattr(owner, name) if isinstance(owner, type(sys))
-                              else owner.__dict__[name]))
-        setattr(owner, name, replacement)
-
     def _patch_method(self, cls, name: str, key: str, category: str, after=None, required=False) -> bool:
         if name not in cls.__dict__:
             if required:
@@ -175,9 +161,9 @@ class _Instrument:
         import scipy.linalg
         import scipy.sparse.linalg
 
-        import ddg.api  # noqa: F401  (loads every module whose references are rebound below)
+        importlib.import_module("ddg.api")  # loads every module whose references are rebound below
         from ddg.models import plate
-        from ddg.solve import banded, continuation, stability
+        from ddg.solve import banded, stability
         from ddg.solve.banded import BandAssembler, SymmetricBanded
 
         inst = self
@@ -252,62 +238,8 @@ class _Instrument:
         self._patch_function(scipy.linalg, "eigvals_banded", "scipy.linalg.eigvals_banded", "eigen")
         del banded  # imported so its `sla` module attribute lookups see the patched scipy functions
 
-        # Newton solves: who called them, iterations, converged or not
-        newton = continuation.__dict__["newton"]
-
-        @functools.wraps(newton)
-        def newton_counting(model, q, *args, **kwargs):
-            caller = sys._getframe(1).f_code.co_name
-            result = newton(model, q, *args, **kwargs)
-            rec = {"caller": caller, "iterations": int(result.iterations), "converged": bool(result.converged),
-                   "minimize": bool(kwargs.get("minimize", False))}
-            inst.newton_calls.append(rec)
-            step = inst._current_step
-            if step is not None:
-                step["newton_solves"] += 1
-                step["iterations_all"] += rec["iterations"]
-                if not rec["converged"]:
-                    step["failed_solves"] += 1
-                    step["iterations_failed"] += rec["iterations"]
-            return result
-
-        self._set(continuation, "newton", newton_counting)
-
-        PF = continuation.PathFollower
-
-        def stepper(name):
-            original = PF.__dict__[name]
-            sig = inspect.signature(original)
-
-            @functools.wraps(original)
-            def wrapper(self_, *args, **kwargs):
-                L = self_.model.strip.length
-                try:
-                    bound = sig.bind(self_, *args, **kwargs).arguments
-                    compression, shear = float(bound.get("compression", math.nan)), float(bound.get("shear", 0.0))
-                except (TypeError, ValueError):
-                    compression, shear = math.nan, math.nan
-                step = {"dL_over_L": compression / L, "dW_over_L": shear / L, "newton_solves": 0,
-                        "iterations_all": 0, "failed_solves": 0, "iterations_failed": 0}
-                inst._current_step = step
-                t0 = time.perf_counter()
-                try:
-                    return original(self_, *args, **kwargs)
-                finally:
-                    step["time_s"] = time.perf_counter() - t0
-                    inst._current_step = None
-                    inst.steps.append(step)
-
-            return wrapper
-
-        for name in ("advance", "start_compression"):
-            if name in PF.__dict__:
-                self._set(PF, name, stepper(name))
-
-    def restore(self) -> None:
-        while self._patches:
-            owner, name, original = self._patches.pop()
-            setattr(owner, name, original)
+        # Newton solves (who called them, iterations, converged or not) and the recorded steps
+        self.install_path_counters()
 
 
 # ---------------------------------------------------------------------------- one run (child)
@@ -316,23 +248,15 @@ def _run_once(triangles: int, config: dict) -> dict:
 
     fingerprint = source_fingerprint()
     inst = _Instrument()
-    inst.install()
-    try:
-        strip = ddg.Strip.from_ratios(config["width_ratio"], COMPRESSION_RATIO)
-        protocol = ddg.LoadingProtocol(COMPRESSION_RATIO, config["shear_ratio"],
-                                       compression_steps=config["compression_steps"],
-                                       shear_steps=config["shear_steps"])
-        c0, t0 = time.process_time(), time.perf_counter()
-        result = ddg.simulate(strip, protocol, model="plate", resolution=triangles)
-        wall = time.perf_counter() - t0
-        cpu = time.process_time() - c0
-    finally:
-        inst.restore()
+    strip = ddg.Strip.from_ratios(config["width_ratio"], COMPRESSION_RATIO)
+    protocol = ddg.LoadingProtocol(COMPRESSION_RATIO, config["shear_ratio"],
+                                   compression_steps=config["compression_steps"],
+                                   shear_steps=config["shear_steps"])
+    result, wall, cpu = timed_simulate(inst, strip, protocol, "plate", triangles)
 
     s = result.summary
     model = result.model
     rows = result.rows
-    shear_rows = [r for r in rows if r["stage"] == "shear"]
     its = int(s["newton_iterations"])
 
     # level-1 split and the sub-split of evaluate
@@ -352,17 +276,6 @@ def _run_once(triangles: int, config: dict) -> dict:
     }
     evals = {k: {"calls": v[0], "time_s": v[1], "per_newton_iteration": v[0] / its if its else None,
                  "ms_per_call": 1e3 * v[1] / v[0] if v[0] else None} for k, v in inst.eval_kinds.items()}
-
-    by_caller = defaultdict(lambda: {"solves": 0, "iterations": 0, "failed": 0, "iterations_failed": 0})
-    for rec in inst.newton_calls:
-        b = by_caller[rec["caller"] + (" (minimize)" if rec["minimize"] else "")]
-        b["solves"] += 1
-        b["iterations"] += rec["iterations"]
-        if not rec["converged"]:
-            b["failed"] += 1
-            b["iterations_failed"] += rec["iterations"]
-    comp_steps = [st for st in inst.steps if st["dW_over_L"] == 0.0]
-    shear_steps = [st for st in inst.steps if st["dW_over_L"] != 0.0]
     K = model.free_matrix(result.final_state.evaluation.hessian) if result.final_state is not None else None
     return {
         "triangles_target": triangles,
@@ -372,13 +285,7 @@ def _run_once(triangles: int, config: dict) -> dict:
         "n_dof": s.get("n_dof"),
         "n_free_dof": s.get("n_free_dof"),
         "bandwidth": int(K.band.shape[0] - 1) if K is not None else getattr(model, "bandwidth", None),
-        "wall_time_s": wall,
-        "cpu_time_s": cpu,
-        "library_wall_time_s": s.get("wall_time_s"),
-        "newton_iterations": its,
-        "time_per_newton_iteration_ms": 1e3 * wall / its if its else None,
-        "recorded_steps": len(rows),
-        "recorded_shear_steps": len(shear_rows),
+        **path_timing(result, wall, cpu),
         "completed": bool(s["converged"]),
         "message": s.get("message", ""),
         "dW_over_L_reached": float(rows[-1]["dW_over_L"]) if rows else None,
@@ -398,89 +305,13 @@ def _run_once(triangles: int, config: dict) -> dict:
             "cholesky_factorisations": {ctx: dict(d) for ctx, d in inst.factorisations.items()},
             "lowest_eigenpairs_paths": {k: {"calls": v[0], "time_s": v[1]} for k, v in inst.eigen_paths.items()},
         },
-        "newton_by_caller": dict(by_caller),
-        "stage": {
-            name: {"time_s": sum(st["time_s"] for st in group), "iterations": sum(st["iterations_all"] for st in group),
-                   "failed_solves": sum(st["failed_solves"] for st in group)}
-            for name, group in (("compression", comp_steps), ("shear", shear_steps))
-        },
+        "newton_by_caller": newton_by_caller(
+            inst.newton_calls, lambda rec: rec["caller"] + (" (minimize)" if rec["minimize"] else "")),
+        "stage": stage_summary(inst.steps),
         "steps": inst.steps,
-        "branch_switches_dW_over_L": [r["dW_over_L"] for r in shear_rows if r.get("branch_switched")],
+        "branch_switches_dW_over_L": [r["dW_over_L"] for r in rows if r["stage"] == "shear" and r.get("branch_switched")],
         "instrumentation_notes": inst.notes,
     }
-
-
-def _child(triangles: int, config: dict, conn) -> None:
-    try:
-        conn.send(("ok", _run_once(triangles, config)))
-    except BaseException:  # report any failure to the parent instead of dying silently
-        conn.send(("error", traceback.format_exc()))
-    finally:
-        conn.close()
-
-
-def run_in_child(triangles: int, config: dict, timeout: float | None) -> tuple[str, object, float]:
-    """Run one N in a fresh process; returns (status, payload, elapsed)."""
-    ctx = mp.get_context("spawn")
-    parent, child = ctx.Pipe(duplex=False)
-    proc = ctx.Process(target=_child, args=(triangles, config, child), daemon=True)
-    t0 = time.perf_counter()
-    proc.start()
-    child.close()
-    try:
-        if parent.poll(timeout):
-            status, payload = parent.recv()
-        else:
-            status, payload = "timeout", f"no result within {timeout:g} s"
-    except EOFError:
-        status, payload = "error", f"child exited with code {proc.exitcode} without a result"
-    elapsed = time.perf_counter() - t0
-    if proc.is_alive():
-        proc.terminate()  # only the child this function started
-    proc.join(5)
-    if proc.is_alive():
-        proc.kill()
-        proc.join()
-    parent.close()
-    return status, payload, elapsed
-
-
-# ---------------------------------------------------------------------------- machine
-def blas_info() -> dict:
-    """The BLAS/LAPACK libraries numpy/scipy were built against (numpy.show_config) and the ones
-    actually loaded in this process (/proc/self/maps: real paths, so Debian's BLAS alternatives show)."""
-    import numpy
-    import scipy.linalg  # noqa: F401  (loads LAPACK)
-
-    buf = io.StringIO()
-    try:
-        with contextlib.redirect_stdout(buf):
-            numpy.show_config()
-    except Exception as exc:  # pragma: no cover
-        buf.write(f"show_config failed: {exc}")
-    built, section = {}, None
-    for line in buf.getvalue().splitlines():
-        if line and not line.startswith(" ") and line.rstrip().endswith(":"):
-            section = line.rstrip()[:-1]
-        elif section and line.strip().startswith("libraries"):
-            built[section] = line.split("=", 1)[1].strip()
-    loaded = set()
-    try:
-        with open("/proc/self/maps") as fh:
-            for line in fh:
-                path = line.split()[-1] if len(line.split()) >= 6 else ""
-                name = os.path.basename(path).lower()
-                if name.startswith("lib") and any(t in name for t in ("blas", "lapack", "mkl", "blis", "atlas")):
-                    loaded.add(path)
-    except OSError:
-        pass
-    return {"numpy_show_config": built, "loaded": sorted(loaded)}
-
-
-def machine_info() -> dict:
-    info = _rod_machine_info()
-    info["blas"] = blas_info()
-    return info
 
 
 # ---------------------------------------------------------------------------- reporting
@@ -506,9 +337,9 @@ def _run_rows(results: list[dict]) -> list[tuple]:
         out.append((
             str(r["triangles_target"]), str(r["triangles"]), str(r["n_free_dof"]), str(r["bandwidth"]),
             f"{r['wall_time_s']:.2f}", f"{r['cpu_time_s']:.2f}", str(r["newton_iterations"]),
-            _fmt(r["time_per_newton_iteration_ms"], ".2f"), "yes" if r["completed"] else "NO",
-            _fmt(r["dW_over_L_reached"], ".4f") + (f" / {r['dW_max_over_L']:.4f}" if r.get("dW_max_over_L") else ""),
-            str(r["recorded_steps"]), per_it("full"), per_it("gradient"), per_it("energy"), _fmt(full_ms, ".2f"),
+            fmt(r["time_per_newton_iteration_ms"], ".2f"), "yes" if r["completed"] else "NO",
+            fmt(r["dW_over_L_reached"], ".4f") + (f" / {r['dW_max_over_L']:.4f}" if r.get("dW_max_over_L") else ""),
+            str(r["recorded_steps"]), per_it("full"), per_it("gradient"), per_it("energy"), fmt(full_ms, ".2f"),
         ))
     return out
 
@@ -520,26 +351,12 @@ def _split_rows(results: list[dict]) -> list[tuple]:
             continue
         p, f = r["split_ms_per_newton_iteration"], r["split_fraction"]
         out.append((
-            str(r["triangles"]), _fmt(p["evaluate"], ".2f"), _fmt(p["kernels"], ".2f"), _fmt(p["assembly"], ".2f"),
-            _fmt(p["evaluate_rest"], ".2f"), _fmt(p["linalg"], ".2f"), _fmt(p["eigen"], ".2f"), _fmt(p["other"], ".2f"),
+            str(r["triangles"]), fmt(p["evaluate"], ".2f"), fmt(p["kernels"], ".2f"), fmt(p["assembly"], ".2f"),
+            fmt(p["evaluate_rest"], ".2f"), fmt(p["linalg"], ".2f"), fmt(p["eigen"], ".2f"), fmt(p["other"], ".2f"),
             f"{100 * f['evaluate']:.0f}", f"{100 * f['kernels']:.0f}", f"{100 * f['assembly']:.0f}",
             f"{100 * f['linalg']:.0f}", f"{100 * f['eigen']:.0f}", f"{100 * f['other']:.0f}",
         ))
     return out
-
-
-def text_table(header, rows) -> str:
-    rows = [header] + rows
-    widths = [max(len(row[i]) for row in rows) for i in range(len(header))]
-    lines = ["  ".join(c.rjust(w) for c, w in zip(row, widths)) for row in rows]
-    lines.insert(1, "  ".join("-" * w for w in widths))
-    return "\n".join(lines)
-
-
-def markdown_table(header, rows) -> str:
-    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---:" for _ in header) + "|"]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(lines)
 
 
 def _slope(xs, ys):
@@ -550,49 +367,34 @@ def _slope(xs, ys):
 def scaling(results: list[dict]) -> dict:
     ok = [r for r in results if r["status"] == "ok" and r["completed"]]
     ts = [r["triangles"] for r in ok]
-    return {
-        "triangles_fitted": ts,
-        "wall_time_slope": _slope(ts, [r["wall_time_s"] for r in ok]),
-        "newton_iterations_slope": _slope(ts, [r["newton_iterations"] for r in ok]),
-        "time_per_iteration_slope": _slope(ts, [r["time_per_newton_iteration_ms"] for r in ok]),
-        "category_slopes": {c: _slope(ts, [max(r["split_s"][c], 1e-12) for r in ok])
-                            for c in (*LEVEL1, *LEVEL2, "other")},
-    }
+    return {"triangles_fitted": ts, **path_slopes(ts, ok, (*LEVEL1, *LEVEL2, "other"), _slope)}
+
+
+def _run_note(r: dict) -> str:
+    st = r["stage"]
+    worst, failed, caller = newton_notes(r)
+    fac = r["calls"]["cholesky_factorisations"]
+    fac_txt = "; ".join(f"{ctx}: " + ", ".join(f"{n} {k}" for k, n in d.items()) for ctx, d in fac.items())
+    ld = r["linalg_detail"]
+    return (
+        f"N = {r['triangles_target']} ({r['triangles']} triangles): {r['message']!r}. Compression "
+        f"{st['compression']['iterations']} its / {st['compression']['time_s']:.2f} s, shear "
+        f"{st['shear']['iterations']} its / {st['shear']['time_s']:.2f} s; iterations in failed Newton solves "
+        f"{failed}; by caller: {caller}; most expensive recorded steps: {worst or 'none'}; branch switches at dW/L = "
+        f"{', '.join(f'{x:.4f}' for x in r['branch_switches_dW_over_L']) or 'none'}. Linear algebra: Cholesky "
+        f"{ld['cholesky_s']:.2f} s, solves {ld['solve_s']:.2f} s (of which banded LU on indefinite matrices "
+        f"{ld['lu_solve_banded_inside_solve_s']:.2f} s); Cholesky factorisations by context: {fac_txt or 'none'}. "
+        "Eigenvalue calls: " + (eigen_paths_text(r) or "none")
+        + "." + (f" Instrumentation notes: {'; '.join(r['instrumentation_notes'])}." if r["instrumentation_notes"] else "")
+    )
 
 
 def observations(results: list[dict]) -> list[str]:
-    notes = []
-    for r in results:
-        if r["status"] != "ok":
-            notes.append(f"N = {r['triangles_target']}: {r['status']} ({r.get('error', '')})".strip())
-            continue
-        st = r["stage"]
-        nb = r["newton_by_caller"]
-        steps = sorted(r["steps"], key=lambda s: -s["iterations_all"])[:3]
-        worst = ", ".join(f"dL/L={s['dL_over_L']:.3f} dW/L={s['dW_over_L']:.4f}: {s['iterations_all']} its, "
-                          f"{s['time_s']:.2f} s ({s['newton_solves']} solves, {s['failed_solves']} failed)" for s in steps)
-        failed = sum(b["iterations_failed"] for b in nb.values())
-        caller = ", ".join(f"{k} {v['solves']} solves/{v['iterations']} its" for k, v in sorted(nb.items()))
-        fac = r["calls"]["cholesky_factorisations"]
-        fac_txt = "; ".join(f"{ctx}: " + ", ".join(f"{n} {k}" for k, n in d.items()) for ctx, d in fac.items())
-        ld = r["linalg_detail"]
-        notes.append(
-            f"N = {r['triangles_target']} ({r['triangles']} triangles): {r['message']!r}. Compression "
-            f"{st['compression']['iterations']} its / {st['compression']['time_s']:.2f} s, shear "
-            f"{st['shear']['iterations']} its / {st['shear']['time_s']:.2f} s; iterations in failed Newton solves "
-            f"{failed}; by caller: {caller}; most expensive recorded steps: {worst or 'none'}; branch switches at dW/L = "
-            f"{', '.join(f'{x:.4f}' for x in r['branch_switches_dW_over_L']) or 'none'}. Linear algebra: Cholesky "
-            f"{ld['cholesky_s']:.2f} s, solves {ld['solve_s']:.2f} s (of which banded LU on indefinite matrices "
-            f"{ld['lu_solve_banded_inside_solve_s']:.2f} s); Cholesky factorisations by context: {fac_txt or 'none'}. "
-            "Eigenvalue calls: " + ("; ".join(f"{k} {v['calls']} calls/{v['time_s']:.2f} s"
-                                              for k, v in r["calls"]["lowest_eigenpairs_paths"].items()) or "none")
-            + "." + (f" Instrumentation notes: {'; '.join(r['instrumentation_notes'])}." if r["instrumentation_notes"] else "")
-        )
-    return notes
+    return run_notes(results, lambda r: f"N = {r['triangles_target']}", _run_note)
 
 
 def markdown_report(report: dict) -> str:
-    sc, mi, scene = report["scaling"], report["machine"], report["scene"]
+    sc, scene = report["scaling"], report["scene"]
     results = report["results"]
     lines = [
         "# Plate solver, full path: speed",
@@ -601,11 +403,9 @@ def markdown_report(report: dict) -> str:
         f"steps, then shear to dW/L = {scene['shear_ratio']} in {scene['shear_steps']} recorded steps, model "
         f"\"plate\" on the structured mesh with about N triangles (`python -m benchmarks.plate_path`). Wall time is "
         f"the best of {report['repeat']} run(s) per N, each in a fresh process.",
-        "",
-        "## Runs",
-        "",
-        markdown_table(RUN_HEADER, _run_rows(results)),
-        "",
+    ]
+    lines += table_section(
+        "Runs", RUN_HEADER, _run_rows(results),
         "triangles = `result.model.mesh.triangle_count`; free DOF = `summary['n_free_dof']`; band = bandwidth of the "
         "free-DOF Hessian (lower band storage rows - 1); cpu s = CPU time of the child process during the run (above "
         "the wall time when BLAS uses a second thread, below it when the process waited for a core); Newton its = "
@@ -613,17 +413,12 @@ def markdown_report(report: dict) -> str:
         "its last load (the message is below); dW/L reached = the last recorded row / the largest asked. Evaluations "
         "per Newton iteration: full = energy + gradient + Hessian (one per accepted step and one at the start of "
         "each solve), grad = energy + gradient (line-search trials on indefinite Hessians), energy = energy only "
-        "(line-search trials after a rejected full step).",
-        "",
-        "## Time per Newton iteration",
-        "",
-        markdown_table(SPLIT_HEADER, _split_rows(results)),
-        "",
+        "(line-search trials after a rejected full step).")
+    lines += table_section(
+        "Time per Newton iteration", SPLIT_HEADER, _split_rows(results),
         "Milliseconds per Newton iteration (category time / Newton iterations; the evaluations, factorisations and "
-        "eigen-solves outside the iterations proper are spread over them) and share of the wall time:",
-        "",
-    ]
-    lines += [f"- {CATEGORY_LABELS[k]}" for k in ("evaluate", "kernels", "assembly", "evaluate_rest", "linalg",
+        "eigen-solves outside the iterations proper are spread over them) and share of the wall time:")
+    lines += [""] + [f"- {CATEGORY_LABELS[k]}" for k in ("evaluate", "kernels", "assembly", "evaluate_rest", "linalg",
                                                   "eigen", "other")]
     lines += [
         "",
@@ -633,39 +428,12 @@ def markdown_report(report: dict) -> str:
         "`lowest_eigenpairs` are eigenvalue work, not (b); kernels and assembly are counted inside (a). Per-function "
         "inclusive times by enclosing category are in the JSON (`calls.by_function`).",
         "",
-        f"- growth exponent d log(wall time) / d log(triangles) over {sc['triangles_fitted']}: "
-        f"**{_fmt(sc['wall_time_slope'], '.2f')}** (Newton iterations: {_fmt(sc['newton_iterations_slope'], '.2f')}, "
-        f"time per iteration: {_fmt(sc['time_per_iteration_slope'], '.2f')}); per category: "
-        + ", ".join(f"{k} {_fmt(v, '.2f')}" for k, v in sc["category_slopes"].items()),
-        f"- load average (1 min) before / after the runs: {report['load_average'][0]} / {report['load_average'][1]} "
-        "(other processes on the machine inflate wall times)",
-        "",
-        "## Per run",
-        "",
+        f"- growth exponent d log(wall time) / d log(triangles) over {sc['triangles_fitted']}: " + slopes_markdown(sc),
+        load_line(report),
     ]
-    lines += [f"- {n}" for n in report["observations"]]
-    blas = mi.get("blas", {})
-    lines += [
-        "",
-        "## Machine",
-        "",
-        f"{mi['cpu_count']} CPUs ({mi['cpu_model']}), {mi['platform']}, Python {mi['python']}, numpy {mi['numpy']}, "
-        f"scipy {mi['scipy']}, ddg {mi['ddg']}; {mi['date']}. BLAS/LAPACK loaded: "
-        + ("; ".join(f"`{x}`" for x in blas.get("loaded", [])) or "unknown")
-        + f". Thread settings: {mi['thread_env']}. ddg sources sha256 `{report['ddg_source_sha256'][:16]}`"
-        + (" (CHANGED during the run: runs may mix library versions)" if report["ddg_source_changed_during_run"] else "")
-        + ".",
-        "",
-    ]
+    lines += section("Per run", report["observations"])
+    lines += machine_section(report)
     return "\n".join(lines)
-
-
-def ratio(text: str) -> float:
-    """A ratio given as a decimal or a fraction: 0.1667 or 1/6."""
-    try:
-        return float(Fraction(text))
-    except (ValueError, ZeroDivisionError):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number or fraction") from None
 
 
 def main(argv=None) -> int:
@@ -687,32 +455,15 @@ def main(argv=None) -> int:
     config = {"width_ratio": args.width_ratio, "shear_ratio": args.shear_ratio,
               "compression_steps": args.compression_steps, "shear_steps": args.shear_steps}
 
-    fingerprint_start = source_fingerprint()
-    load_start = _load()
-    results = []
-    for n in args.triangles:
-        best, attempts = None, []
-        for k in range(args.repeat):
-            status, payload, elapsed = run_in_child(n, config, timeout)
-            if status == "ok":
-                attempts.append(payload["wall_time_s"])
-                if best is None or payload["wall_time_s"] < best["wall_time_s"]:
-                    best = payload
-                print(f"N = {n} run {k + 1}/{args.repeat}: {payload['triangles']} triangles, "
-                      f"{payload['wall_time_s']:.2f} s, {payload['newton_iterations']} Newton its, "
-                      f"complete {payload['completed']}", file=sys.stderr)
-            else:
-                print(f"N = {n} run {k + 1}/{args.repeat}: {status} after {elapsed:.0f} s", file=sys.stderr)
-                if best is None:
-                    best = {"triangles_target": n, "status": status, "error": payload if status == "error" else
-                            f"stopped after {elapsed:.0f} s (--timeout {args.timeout:g})"}
-                    if status == "error":
-                        print(payload, file=sys.stderr)
-                break  # a timeout or crash will repeat; do not wait again
-        if "status" not in best:
-            best["status"] = "ok"
-            best["all_wall_times_s"] = attempts
-        results.append(best)
+    provenance = Provenance()
+    results = [
+        best_of(functools.partial(run_in_child, _run_once, (n, config), timeout), args.repeat, f"N = {n}",
+                {"triangles_target": n},
+                lambda p: (f"{p['triangles']} triangles, {p['wall_time_s']:.2f} s, {p['newton_iterations']} Newton "
+                           f"its, complete {p['completed']}"),
+                args.timeout)
+        for n in args.triangles
+    ]
 
     report = {
         "benchmark": "plate_path",
@@ -724,33 +475,18 @@ def main(argv=None) -> int:
         "split_categories": CATEGORY_LABELS,
         "method": "run-time timer wrappers; nested timed calls counted once, by the outermost (see module docstring)",
         "results": results,
-        "scaling": scaling(results),
-        "machine": machine_info(),
-        "ddg_source_sha256": fingerprint_start,
-        "load_average": [load_start, _load()],
-        "ddg_source_changed_during_run": source_fingerprint() != fingerprint_start or any(
-            r.get("ddg_source_sha256", fingerprint_start) != fingerprint_start for r in results),
     }
-    report["observations"] = observations(results)
-
-    out = Path(args.out)
-    atomic_write_text(out / "plate_path.json", json.dumps(report, indent=1, default=float) + "\n")
-    atomic_write_text(out / "plate_path.md", markdown_report(report))
+    wrote = finish_path_report(report, provenance, scaling, observations, markdown_report, args.out, blas=True)
 
     sc = report["scaling"]
-    if report["ddg_source_changed_during_run"]:
-        print("WARNING: the ddg sources changed while the benchmark ran; the runs may mix library versions",
-              file=sys.stderr)
     print(text_table(RUN_HEADER, _run_rows(results)))
     print()
     print(text_table(SPLIT_HEADER, _split_rows(results)))
     print()
-    print(f"growth exponent d log(time)/d log(triangles) over {sc['triangles_fitted']}: "
-          f"{_fmt(sc['wall_time_slope'], '.2f')} (Newton iterations {_fmt(sc['newton_iterations_slope'], '.2f')}, "
-          f"time/iteration {_fmt(sc['time_per_iteration_slope'], '.2f')})")
+    print(f"growth exponent d log(time)/d log(triangles) over {sc['triangles_fitted']}: {slopes_text(sc)}")
     for n in report["observations"]:
         print("-", n)
-    print(f"wrote {out / 'plate_path.json'} and {out / 'plate_path.md'}")
+    print(wrote)
     return 0
 
 

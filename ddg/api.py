@@ -112,6 +112,33 @@ class _Progress:
             sys.stderr.write("\n")
 
 
+def _track_brackets(brackets: dict, model, state, phase: str) -> None:
+    """Remember the recorded states that bracket the phase changes U -> US and US -> S."""
+    from .solve.thresholds import Snapshot
+
+    if phase == "U" and brackets["first_us"] is None:
+        brackets["last_u"] = Snapshot.take(model, state)
+    elif phase.startswith("US"):
+        if brackets["first_us"] is None and brackets["last_u"] is not None:
+            brackets["first_us"] = state.shear
+        if brackets["first_s"] is None:
+            brackets["last_us"] = Snapshot.take(model, state)
+    elif phase.startswith("S") and brackets["first_s"] is None and brackets["last_us"] is not None:
+        brackets["first_s"] = Snapshot.take(model, state)
+
+
+def _fill_thresholds(summary: dict, model, options, brackets: dict) -> None:
+    from .solve.thresholds import shear_thresholds
+
+    t0 = time.perf_counter()
+    found = shear_thresholds(model, options, brackets["last_u"], brackets["first_us"], brackets["last_us"],
+                             brackets["first_s"])
+    L = model.strip.length
+    for key, name in (("dW1", "dW1_over_L"), ("dW2", "dW2_over_L"), ("dW2_S_stable", "dW2_S_stable_over_L")):
+        summary[name] = None if found[key] is None else abs(found[key]) / L
+    summary["threshold_wall_time_s"] = time.perf_counter() - t0
+
+
 def versions() -> dict:
     from . import __version__
 
@@ -134,6 +161,8 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
         "dW_max_over_L": strip.shear_limit(protocol.compression_ratio * L) / L,
         "dW1_over_L": None,
         "dW2_over_L": None,
+        "dW2_S_stable_over_L": None,
+        "threshold_wall_time_s": None,
         "n_dof": model.n_dof,
         "n_free_dof": int(np.arange(model.n_dof)[model.free].size),
         "newton_iterations": 0,
@@ -158,6 +187,7 @@ def simulate(
     dynamic_options=None,
     mesh=None,
     frames: bool = False,
+    thresholds: bool = True,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
@@ -167,7 +197,9 @@ def simulate(
     path.csv), the summary and the deformed centerline (w = 0) per row; writes them to `out`
     (path.csv, summary.json, centerline.csv) if given, also when the run stops early (the
     converged part of the path is kept). frames=True also writes out/frames/frame_NNNNN.vtu per
-    recorded step and out/frames/frames.pvd (ParaView). mesh: see make_model.
+    recorded step and out/frames/frames.pvd (ParaView). mesh: see make_model. thresholds=True
+    locates dW1 and dW2 from stability after the path (ddg.solve.thresholds; summary keys
+    dW1_over_L, dW2_over_L, dW2_S_stable_over_L) when the recorded path brackets them.
     """
     if solver not in ("static", "dynamic"):
         raise InputError(f"solver = {solver!r} is not available; choose 'static' or 'dynamic'")
@@ -206,9 +238,13 @@ def simulate(
     t0 = time.perf_counter()
     state = None
 
+    brackets = {"last_u": None, "first_us": None, "last_us": None, "first_s": None}
+
     def record(stage):
         row = observe(instance, state, stage, options.eigenvalues)
         rows.append(row)
+        if stage == "shear" and thresholds:
+            _track_brackets(brackets, instance, state, row["phase"])
         centerlines.append(instance.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
         if writer is not None:
             writer.write(instance.positions(state.q), step=len(rows) - 1, dL_over_L=row["dL_over_L"],
@@ -235,6 +271,8 @@ def simulate(
         raise
     finally:
         progress_bar.close()
+        if thresholds and options.eigenvalues and state is not None:
+            _fill_thresholds(summary, instance, options, brackets)
         summary["newton_iterations"] = follower.newton_iterations
         summary["wall_time_s"] = time.perf_counter() - t0
         summary["recorded_steps"] = len(rows)

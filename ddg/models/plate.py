@@ -139,6 +139,21 @@ class PlateModel(BandedModel):
         where = self.mesh.interpolation_matrix(np.stack([s, np.zeros_like(s)], axis=1))
         return self._interpolate(q, where), s
 
+    def symmetry_partners(self) -> tuple[np.ndarray, np.ndarray]:
+        """Nodes whose reference point (x, y) has a node at (L - x, -y), with that node; the
+        structured mesh pairs every node, other meshes whichever nodes match to 1e-9 L."""
+        cached = getattr(self, "_partners", None)
+        if cached is None:
+            L = self.strip.length
+            nodes = self.mesh.nodes
+            key = lambda p: np.round(p / (1e-9 * L)).astype(np.int64)
+            lookup = {tuple(k): i for i, k in enumerate(key(nodes))}
+            mirrored = key(np.stack([L - nodes[:, 0], -nodes[:, 1]], axis=1))
+            found = [(i, lookup.get(tuple(k), -1)) for i, k in enumerate(mirrored)]  # set-up only
+            pairs = np.array([(i, j) for i, j in found if j >= 0])
+            cached = self._partners = (pairs[:, 0], pairs[:, 1])
+        return cached
+
     def resolution_indicators(self, q: np.ndarray) -> dict:
         """Largest angle between neighbouring triangle normals (degrees) and largest edge strain."""
         mesh = self.mesh

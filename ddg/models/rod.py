@@ -116,6 +116,11 @@ class RodModel(BandedModel):
         sn = self.centerline.node_arclength
         return np.stack([np.interp(s, sn, x[:, k]) for k in range(3)], axis=1), s
 
+    def symmetry_partners(self) -> tuple[np.ndarray, np.ndarray]:
+        """Node i sits at s = (i - 1/2) h, its mirror node M - 1 - i at L - s."""
+        i = np.arange(self.nodes)
+        return i, i[::-1]
+
     def resolution_indicators(self, q: np.ndarray) -> dict:
         """Largest turning angle between neighbouring edges (degrees) and largest edge strain."""
         x = q[self.node_dofs]

@@ -1,0 +1,121 @@
+"""The shear thresholds dW1 (U to US, a supercritical pitchfork) and dW2 (US to S), located from
+the stability of the discrete equilibria instead of by eye.
+
+- dW1: on the symmetric U branch, followed without branch switching, lambda_min (the lowest
+  eigenvalue of the free-DOF Hessian) changes sign; regula falsi (Illinois) on dW until the
+  bracket is below the tolerance (1e-4 L by default).
+- dW2, the paper's: the smallest dW at which the stable path (branch switching on) is in the
+  point-symmetric S state; bisection on the phase label of the state reached from the last US
+  state (to 1e-3 L by default).
+- dW2_S_stable: where the S branch itself becomes stable, lambda_min of S (followed backwards
+  without switching) changing sign; it differs from dW2 when US ends in a fold and snaps to S.
+
+Each refinement starts from a recorded equilibrium (its DOFs and the rod's reference frames) and
+uses its own PathFollower, so the recorded path is not disturbed.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+from .continuation import ContinuationFailure, PathFollower, State
+from .stability import lowest_modes
+
+
+@dataclass
+class Snapshot:
+    """A recorded equilibrium with the model's frame state, to restart continuation from."""
+    state: State
+    frames: object
+
+    @classmethod
+    def take(cls, model, state: State) -> "Snapshot":
+        return cls(state, model.save_frames())
+
+
+def _follower(model, options, switching: bool) -> PathFollower:
+    return PathFollower(model, replace(options, branch_switching=switching))
+
+
+def _advance(model, options, snapshot: Snapshot, shear: float, switching: bool) -> State | None:
+    model.restore_frames(snapshot.frames)
+    follower = _follower(model, options, switching)
+    follower._remember(snapshot.state, restart=True)
+    try:
+        return follower.advance(snapshot.state, snapshot.state.compression, shear)
+    except ContinuationFailure:
+        return None
+
+
+def _lambda_min(model, state: State) -> float:
+    return float(lowest_modes(model, state.evaluation.hessian, 1)[0])
+
+
+def locate_sign_change(model, options, start: Snapshot, other: float, tolerance: float) -> float | None:
+    """dW where lambda_min changes sign on the branch through `start`, between start.state.shear
+    and `other` (either side), following the branch without switching. None if the branch
+    cannot be followed to `other` or lambda_min has the same sign at both ends."""
+    a, lam_a = start.state.shear, _lambda_min(model, start.state)
+    end = _advance(model, options, start, other, switching=False)
+    if end is None:
+        return None
+    b, lam_b = other, _lambda_min(model, end)
+    if lam_a * lam_b > 0:
+        return None
+    side = 0
+    while abs(b - a) > tolerance:
+        guess = (a * lam_b - b * lam_a) / (lam_b - lam_a)
+        guess = min(max(guess, min(a, b) + 0.01 * abs(b - a)), max(a, b) - 0.01 * abs(b - a))
+        state = _advance(model, options, start, guess, switching=False)
+        if state is None:
+            return None
+        lam = _lambda_min(model, state)
+        if lam * lam_a > 0:
+            a, lam_a = guess, lam
+            if side == -1:
+                lam_b *= 0.5  # Illinois: keep the stale end from stalling the secant
+            side = -1
+        else:
+            b, lam_b = guess, lam
+            if side == 1:
+                lam_a *= 0.5
+            side = 1
+    return (a * lam_b - b * lam_a) / (lam_b - lam_a) if lam_b != lam_a else 0.5 * (a + b)
+
+
+def locate_phase_change(model, options, start: Snapshot, first_after: float, is_after, tolerance: float) -> float | None:
+    """Smallest dW in (start.state.shear, first_after] whose stable state (branch switching on,
+    continued from `start`) satisfies is_after(state); bisection, None if a step fails."""
+    lo, hi = start, first_after
+    while hi - lo.state.shear > tolerance:
+        mid = 0.5 * (lo.state.shear + hi)
+        state = _advance(model, options, lo, mid, switching=True)
+        if state is None:
+            return None
+        if is_after(state):
+            hi = mid
+        else:
+            lo = Snapshot.take(model, state)
+    return hi
+
+
+def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | None,
+                     last_us: Snapshot | None, first_s: Snapshot | None,
+                     tolerances: tuple[float, float] = (1e-4, 1e-3)) -> dict:
+    """dW1, dW2 and dW2_S_stable (in metres; None where not bracketed by the recorded path)."""
+    from ..observables import phase_label
+
+    L = model.strip.length
+    saved = model.save_frames()
+    out = {"dW1": None, "dW2": None, "dW2_S_stable": None}
+    try:
+        if last_u is not None and first_us is not None:
+            out["dW1"] = locate_sign_change(model, options, last_u, first_us, tolerances[0] * L)
+        if last_us is not None and first_s is not None:
+            def in_s(state):
+                return phase_label(model, state.q, state.compression, state.shear).startswith("S")
+
+            out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L)
+            out["dW2_S_stable"] = locate_sign_change(model, options, first_s, last_us.state.shear, tolerances[1] * L)
+    finally:
+        model.restore_frames(saved)
+    return out

@@ -1,0 +1,83 @@
+"""Thresholds located from stability (ddg.solve.thresholds) and phase labels from symmetry."""
+import numpy as np
+import pytest
+
+import ddg
+
+
+def rod_path(compression_ratio, nodes=100, shear_ratio=None, **options):
+    strip = ddg.Strip.from_ratios(0.05, compression_ratio)
+    protocol = ddg.LoadingProtocol(compression_ratio, shear_ratio=shear_ratio, compression_steps=20)
+    result = ddg.simulate(strip, protocol, model="rod", resolution=nodes, options=ddg.ContinuationOptions(**options))
+    assert result.converged, result.summary["message"]
+    return result
+
+
+@pytest.fixture(scope="module")
+def narrow_rod():
+    return {m: rod_path(0.5, m) for m in (100, 200)}
+
+
+def test_rod_thresholds_match_the_paper_and_converge_in_M(narrow_rod):
+    """W/L = 1/20, dL/L = 1/2: paper dW1/L ~ 0.36 and dW2/L ~ 0.52 (by eye, Fig. 6a). Measured:
+    0.3516 / 0.5237 at M = 100 and 0.3517 / 0.5245 at M = 200."""
+    coarse, fine = (narrow_rod[m].summary for m in (100, 200))
+    assert coarse["dW1_over_L"] == pytest.approx(0.36, abs=0.02)
+    assert coarse["dW2_over_L"] == pytest.approx(0.52, abs=0.02)
+    assert abs(coarse["dW1_over_L"] - fine["dW1_over_L"]) < 2e-3
+    assert abs(coarse["dW2_over_L"] - fine["dW2_over_L"]) < 2e-3
+    # the S branch becomes stable no later than the stable path reaches it
+    assert coarse["dW2_S_stable_over_L"] <= coarse["dW2_over_L"] + 1e-3
+
+
+def test_rod_thresholds_at_quarter_compression():
+    """dL/L = 1/4: paper dW1/L = 0.23, dW2/L = 0.37 (Fig. 7a). Measured 0.2313 and 0.3699."""
+    summary = rod_path(0.25).summary
+    assert summary["dW1_over_L"] == pytest.approx(0.23, abs=0.02)
+    assert summary["dW2_over_L"] == pytest.approx(0.37, abs=0.02)
+
+
+def test_thresholds_do_not_depend_on_the_size_of_the_kick(narrow_rod):
+    """The push off an unstable state only selects the branch; the thresholds come from
+    stability, so a 100x smaller kick gives the same dW1 (to its 1e-4 tolerance) and dW2 (1e-3)."""
+    small = rod_path(0.5, 100, kick=1e-5).summary
+    reference = narrow_rod[100].summary
+    assert abs(small["dW1_over_L"] - reference["dW1_over_L"]) < 1e-4
+    assert abs(small["dW2_over_L"] - reference["dW2_over_L"]) < 1e-3
+
+
+def test_phase_labels_follow_U_then_US_then_S(narrow_rod):
+    """Up to 0.03 L before dW_max (there the strip is pulled nearly straight, its deflection falls
+    below 0.5 % of L and the S lobes swap sides: S- from dW/L = 0.797 of 0.8175)."""
+    result = narrow_rod[100]
+    dw_all = result.column("dW_over_L", "shear")
+    keep = dw_all < result.summary["dW_max_over_L"] - 0.03
+    phases = [p for p, k in zip(result.column("phase", "shear"), keep) if k]
+    dw = dw_all[keep]
+    order = {"U": 0, "US+": 1, "S+": 2}
+    ranks = [order.get(p, 3) for p in phases]
+    assert ranks == sorted(ranks) and set(phases) == {"U", "US+", "S+"}
+    summary = result.summary
+    first_us = dw[phases.index("US+")]
+    first_s = dw[phases.index("S+")]
+    assert dw[phases.index("US+") - 1] < summary["dW1_over_L"] <= first_us
+    assert dw[phases.index("S+") - 1] < summary["dW2_over_L"] <= first_s + 1e-12
+    h = result.column("H_mid_over_L", "shear")[keep]
+    assert np.all(np.abs(h[np.array([p.startswith("S") for p in phases])]) < 1e-8)
+
+
+def test_reported_stable_states_have_positive_lambda_min(narrow_rod):
+    result = narrow_rod[100]
+    stable = result.column("stable").astype(bool)
+    assert np.all(result.column("lambda_min")[stable] > 0)
+
+
+def test_without_branch_switching_the_rod_stays_on_U_and_reports_it_unstable(narrow_rod):
+    result = rod_path(0.5, 100, shear_ratio=0.40, branch_switching=False)
+    dw1 = narrow_rod[100].summary["dW1_over_L"]
+    dw = result.column("dW_over_L", "shear")
+    past = dw > dw1 + 1e-3
+    assert set(result.column("phase", "shear")) == {"U"}
+    assert np.all(result.column("lambda_min", "shear")[past] < 0)
+    assert not np.any(result.column("stable", "shear")[past].astype(bool))
+    assert np.all(result.column("lambda_min", "shear")[dw < dw1 - 1e-3] > 0)

@@ -45,6 +45,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--compression-steps", type=int, default=40, help="recorded compression steps (default 40)")
     sim.add_argument("--shear-steps", type=int, default=120, help="recorded shear steps (default 120)")
     sim.add_argument("--shear-direction", type=int, choices=(1, -1), default=1, help="+1 or -1 (default +1)")
+    sim.add_argument("--branch", choices=("+", "-"), default="+",
+                     help="at the pitchfork follow US+ and then S+ (default) or US- and S-")
     sim.add_argument("--no-branch-switching", action="store_true",
                      help="stay on the branch the path starts on, even where it is unstable")
     sim.add_argument("--solver", choices=("static", "dynamic"), default="static",
@@ -68,7 +70,8 @@ def cmd_simulate(args) -> int:
     if args.max_newton_iterations < 1:
         raise InputError(f"--max-newton-iterations = {args.max_newton_iterations} must be >= 1")
     options = ContinuationOptions(newton=NewtonOptions(max_iterations=args.max_newton_iterations),
-                                  branch_switching=not args.no_branch_switching)
+                                  branch_switching=not args.no_branch_switching,
+                                  branch_sign=1 if args.branch == "+" else -1)
     dynamic_options = None
     if args.solver == "dynamic":
         from .solve.dynamics import DynamicOptions

@@ -81,3 +81,27 @@ def test_without_branch_switching_the_rod_stays_on_U_and_reports_it_unstable(nar
     assert np.all(result.column("lambda_min", "shear")[past] < 0)
     assert not np.any(result.column("stable", "shear")[past].astype(bool))
     assert np.all(result.column("lambda_min", "shear")[dw < dw1 - 1e-3] > 0)
+
+
+def test_US_minus_is_the_mirror_image_of_US_plus():
+    """Leaving the pitchfork along minus the critical mode gives US- then S-: the image of US+ and
+    S+ under the half turn about the vertical axis through the clamps' midpoint (s -> L - s),
+    to solver tolerance (measured 3.5e-9 L), with the same thresholds."""
+    strip = ddg.Strip.from_ratios(0.05, 0.5)
+    L = strip.length
+    runs = {}
+    for sign in (1, -1):
+        protocol = ddg.LoadingProtocol(0.5, shear_ratio=0.6, compression_steps=20, shear_steps=60)
+        runs[sign] = ddg.simulate(strip, protocol, model="rod", resolution=100,
+                                  options=ddg.ContinuationOptions(branch_sign=sign))
+    plus, minus = runs[1], runs[-1]
+    assert set(plus.column("phase", "shear")) == {"U", "US+", "S+"}
+    assert set(minus.column("phase", "shear")) == {"U", "US-", "S-"}
+    for key in ("dW1_over_L", "dW2_over_L"):
+        assert minus.summary[key] == pytest.approx(plus.summary[key], abs=1e-6)
+    worst = 0.0
+    for row, a, b in zip(plus.rows, plus.centerlines, minus.centerlines):
+        c = np.array([0.5 * L * (1 - row["dL_over_L"]), 0.5 * L * row["dW_over_L"]])
+        image = np.stack([2 * c[0] - b[::-1, 0], 2 * c[1] - b[::-1, 1], b[::-1, 2]], axis=1)
+        worst = max(worst, float(np.max(np.abs(a - image))) / L)
+    assert worst < 1e-7

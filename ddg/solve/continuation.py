@@ -32,8 +32,9 @@ class ContinuationOptions:
     eigenvalues: bool = True           # compute lambda_min at every recorded equilibrium
     kick: float = 1e-3                 # size of the push off an unstable state, relative to L
     jump_substep: float = 1.0 / 64     # below this substep a failing branch is left by energy descent
-    predictor: str = "secant"
-    grow_after: int = 2                # easy substeps in a row before the substep doubles           # "secant" (extrapolate the branch), "tangent", or "both" (secant, then tangent)
+    predictor: str = "secant"          # "secant" (extrapolate the branch), "tangent", or "both" (secant, then tangent)
+    grow_after: int = 2                # easy substeps in a row before the substep doubles
+    branch_sign: int = 1               # +1: leave a pitchfork onto the '+' branch (US+), -1: onto US-
 
 
 @dataclass
@@ -233,6 +234,8 @@ class PathFollower:
         mode[model.free] = modes[:, 0]
         mode /= np.max(np.abs(mode[model.node_dofs]))
         sign = 1.0 if model.mode_sign(mode, direction) >= 0 else -1.0
+        if direction == 0:
+            sign *= self.options.branch_sign
         for kick in (self.options.kick, 10 * self.options.kick, 0.1 * self.options.kick):
             saved = model.save_frames()
             q = state.q + sign * kick * self._length * mode

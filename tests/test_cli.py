@@ -82,6 +82,27 @@ def test_run_that_stops_converging_exits_3_and_keeps_the_converged_part(tmp_path
     assert "did not complete" in capsys.readouterr().err
 
 
+def test_run_that_stops_during_shear_says_how_close_to_dw_max_it_got(tmp_path, monkeypatch):
+    """Newton is made to fail once the moving clamp passes dW/L = 0.05 (of 0.1 asked): the message
+    gives the last converged dW/L and its share of dW_max (Eq. B.1)."""
+    import ddg.solve.continuation as continuation
+
+    real_newton = continuation.newton
+
+    def failing_newton(model, q, *args, **kwargs):
+        result = real_newton(model, q, *args, **kwargs)
+        if q[model.node_dofs[-1, 1]] > 0.05 * model.strip.length:
+            result.converged = False
+        return result
+
+    monkeypatch.setattr(continuation, "newton", failing_newton)
+    assert main(SMALL_RUN + ["--out", str(tmp_path)]) == 3
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert "dW/L = 0.05 " in summary["message"] or "dW/L = 0.05;" in summary["message"]
+    share = 100 * 0.05 / summary["dW_max_over_L"]
+    assert f"{share:.2f} % of dW_max/L" in summary["message"], summary["message"]
+
+
 def test_dynamic_solver_writes_the_same_contract(tmp_path):
     args = ["simulate", "--solver", "dynamic", "--clamp-speed", "0.02", "--resolution", "20", "--compression-ratio",
             "0.25", "--shear-ratio", "0.05", "--compression-steps", "4", "--shear-steps", "2", "--quiet",

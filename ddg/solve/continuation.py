@@ -143,9 +143,13 @@ class PathFollower:
                 self._easy_streak = 0
                 self.substep *= 0.5
                 if self.substep < self.options.min_substep:
+                    strip = self.model.strip
+                    limit = strip.shear_limit(state.compression) if state.compression > 0 else float("nan")
+                    reach = (f"; that is {100 * abs(state.shear) / limit:.2f} % of dW_max/L = {limit / self._length:.4g} "
+                             "(Eq. B.1)") if state.shear != 0.0 and limit > 0 else ""
                     raise ContinuationFailure(
                         f"Newton failed to converge beyond dL/L = {state.compression / self._length:.6g}, "
-                        f"dW/L = {state.shear / self._length:.6g} (substep below {self.options.min_substep:g} "
+                        f"dW/L = {state.shear / self._length:.6g}{reach} (substep below {self.options.min_substep:g} "
                         "of a recorded interval)"
                     )
                 continue

@@ -105,3 +105,17 @@ def test_US_minus_is_the_mirror_image_of_US_plus():
         image = np.stack([2 * c[0] - b[::-1, 0], 2 * c[1] - b[::-1, 1], b[::-1, 2]], axis=1)
         worst = max(worst, float(np.max(np.abs(a - image))) / L)
     assert worst < 1e-7
+
+
+@pytest.mark.slow
+def test_plate_dW1_falls_monotonically_with_width():
+    """Paper: the first threshold drops as the strip widens. Measured at ~1500 triangles (dL/L =
+    1/2): 0.339, 0.312, 0.238, 0.171, 0.127 for W/L = 1/20, 1/12, 1/6, 1/3, 1/2 (about 3 min)."""
+    values = []
+    for width_ratio in (1 / 20, 1 / 12, 1 / 6, 1 / 3, 1 / 2):
+        strip = ddg.Strip.from_ratios(width_ratio, 0.5)
+        protocol = ddg.LoadingProtocol(0.5, shear_ratio=0.40, compression_steps=20, shear_steps=40)
+        result = ddg.simulate(strip, protocol, model="plate", resolution=1500)
+        assert result.summary["dW1_over_L"] is not None, result.summary["message"]
+        values.append(result.summary["dW1_over_L"])
+    assert np.all(np.diff(values) < 0), values

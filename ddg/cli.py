@@ -47,6 +47,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--shear-direction", type=int, choices=(1, -1), default=1, help="+1 or -1 (default +1)")
     sim.add_argument("--branch", choices=("+", "-"), default="+",
                      help="at the pitchfork follow US+ and then S+ (default) or US- and S-")
+    sim.add_argument("--no-thresholds", action="store_true",
+                     help="skip locating dW1 and dW2 from stability after the path (summary keys stay null)")
     sim.add_argument("--no-branch-switching", action="store_true",
                      help="stay on the branch the path starts on, even where it is unstable")
     sim.add_argument("--solver", choices=("static", "dynamic"), default="static",
@@ -81,7 +83,7 @@ def cmd_simulate(args) -> int:
         dynamic_options = DynamicOptions(clamp_speed=args.clamp_speed)
     result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
                       progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options,
-                      mesh=args.mesh, frames=args.frames)
+                      mesh=args.mesh, frames=args.frames, thresholds=not args.no_thresholds)
     s = result.summary
     if not args.quiet:
         keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",

@@ -179,10 +179,12 @@ class PathFollower:
         new_clamps = model.clamp_values(compression, shear)
         opts = self.options.newton
         if patient:
-            opts = replace(opts, max_iterations=2 * opts.max_iterations, give_up_after=2 * opts.give_up_after if opts.give_up_after else None, give_up_ratio=0.5)
+            # near thresholds Newton converges only linearly: more iterations, a milder give-up test
+            give_up = 2 * opts.give_up_after if opts.give_up_after else None
+            opts = replace(opts, max_iterations=2 * opts.max_iterations, give_up_after=give_up, give_up_ratio=0.5)
         result = None
         extrapolated = None
-        if self.options.predictor != "tangent" and np.array_equal(state.q, self._history[-1][1]):
+        if self.options.predictor != "tangent" and self._history and np.array_equal(state.q, self._history[-1][1]):
             extrapolated = self._extrapolate(compression, shear)
         if extrapolated is not None:
             q = extrapolated

@@ -31,7 +31,7 @@ class ContinuationOptions:
     branch_switching: bool = True      # leave unstable equilibria along the negative eigenvector
     eigenvalues: bool = True           # compute lambda_min at every recorded equilibrium
     kick: float = 1e-3                 # size of the push off an unstable state, relative to L
-    jump_substep: float = 1.0 / 64     # below this substep a failing branch is left by energy descent
+    jump_substep: float = 1.0 / 16     # below this substep a failing branch is left by energy descent
     predictor: str = "secant"          # "secant" (extrapolate the branch), "tangent", or "both" (secant, then tangent)
     grow_after: int = 2                # easy substeps in a row before the substep doubles
     branch_sign: int = 1               # +1: leave a pitchfork onto the '+' branch (US+), -1: onto US-

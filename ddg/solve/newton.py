@@ -29,8 +29,8 @@ class NewtonOptions:
     # after give_up_after iterations is outside Newton's basin (converging steps take ~3
     # iterations); the caller then halves the step. None disables (near thresholds, where
     # Newton converges only linearly).
-    give_up_after: int | None = 5
-    give_up_ratio: float = 0.05
+    give_up_after: int | None = 4
+    give_up_ratio: float = 0.1
 
 
 @dataclass

@@ -144,30 +144,26 @@ def small_mesh():
 
 
 # --------------------------------------------------------------------------- finite differences
-def fd_gradient(energy, x: np.ndarray, step: float) -> np.ndarray:
+def central_differences(function, x: np.ndarray, step: float) -> np.ndarray:
+    """d function / d x_i by central differences, stacked along the first axis (i over x.ravel())."""
     q = x.ravel().copy()
-    out = np.empty_like(q)
+    rows = []
     for i in range(len(q)):
         q[i] += step
-        plus = energy(q.reshape(x.shape))
+        plus = function(q.reshape(x.shape))
         q[i] -= 2 * step
-        minus = energy(q.reshape(x.shape))
+        minus = function(q.reshape(x.shape))
         q[i] += step
-        out[i] = (plus - minus) / (2 * step)
-    return out
+        rows.append((plus - minus) / (2 * step))
+    return np.array(rows)
+
+
+def fd_gradient(energy, x: np.ndarray, step: float) -> np.ndarray:
+    return central_differences(energy, x, step)
 
 
 def fd_hessian(gradient, x: np.ndarray, step: float) -> np.ndarray:
-    q = x.ravel().copy()
-    columns = []
-    for i in range(len(q)):
-        q[i] += step
-        plus = gradient(q.reshape(x.shape))
-        q[i] -= 2 * step
-        minus = gradient(q.reshape(x.shape))
-        q[i] += step
-        columns.append((plus - minus) / (2 * step))
-    return np.array(columns).T
+    return central_differences(gradient, x, step).T
 
 
 def max_rel_err(approx: np.ndarray, exact: np.ndarray) -> float:

@@ -122,7 +122,7 @@ class PlateMesh:
         if np.any(t[tri_b, k_b] != v1):
             raise InputError("mesh triangles are not consistently oriented")
         hinges = np.stack([v0, v1, opposite_a, opposite_b], axis=1)
-        return hinges, np.stack([tri_a, tri_b], axis=1), interior, np.stack([k_a, k_b], axis=1)
+        return hinges, np.stack([tri_a, tri_b], axis=1), interior
 
     @cached_property
     def hinges(self) -> np.ndarray:
@@ -134,11 +134,6 @@ class PlateMesh:
     def hinge_triangles(self) -> np.ndarray:
         """The two triangles (a, b) of each bending pair, (H, 2)."""
         return self._hinge_data[1]
-
-    @cached_property
-    def hinge_edge_slots(self) -> np.ndarray:
-        """Local index k (edge from vertex k to k + 1) of the shared edge in triangles a and b, (H, 2)."""
-        return self._hinge_data[3]
 
     @cached_property
     def hinge_edges(self) -> np.ndarray:

@@ -146,12 +146,15 @@ class PlateModel(BandedModel):
         if cached is None:
             L = self.strip.length
             nodes = self.mesh.nodes
-            key = lambda p: np.round(p / (1e-9 * L)).astype(np.int64)
-            lookup = {tuple(k): i for i, k in enumerate(key(nodes))}
-            mirrored = key(np.stack([L - nodes[:, 0], -nodes[:, 1]], axis=1))
-            found = [(i, lookup.get(tuple(k), -1)) for i, k in enumerate(mirrored)]  # set-up only
-            pairs = np.array([(i, j) for i, j in found if j >= 0])
-            cached = self._partners = (pairs[:, 0], pairs[:, 1])
+            key = np.round(nodes / (1e-9 * L)).astype(np.int64)
+            image = np.round(np.stack([L - nodes[:, 0], -nodes[:, 1]], axis=1) / (1e-9 * L)).astype(np.int64)
+            order = np.lexsort((key[:, 1], key[:, 0]))
+            sorted_keys = key[order]
+            # position of each image among the sorted node keys (lexicographic search by x, then y)
+            at = np.searchsorted(sorted_keys[:, 0] * (2**31) + sorted_keys[:, 1], image[:, 0] * (2**31) + image[:, 1])
+            at = np.minimum(at, len(order) - 1)
+            match = np.all(sorted_keys[at] == image, axis=1)
+            cached = self._partners = (np.flatnonzero(match), order[at[match]])
         return cached
 
     def resolution_indicators(self, q: np.ndarray) -> dict:

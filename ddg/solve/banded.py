@@ -23,7 +23,13 @@ class BandAssembler:
     def __init__(self, n: int, bandwidth: int):
         self.n = n
         self.bandwidth = bandwidth
-        self._families: list[tuple[np.ndarray, np.ndarray]] = []
+        self._families: list[tuple[np.ndarray, np.ndarray, str]] = []
+        self._all_flat = None  # concatenated targets of all families, built at the first assemble
+
+    def _add(self, flat: np.ndarray, local: np.ndarray, kind: str) -> int:
+        self._families.append((flat, local, kind))
+        self._all_flat = None
+        return len(self._families) - 1
 
     def add_family(self, offsets: np.ndarray, size: int) -> int:
         a, b = np.tril_indices(size)
@@ -31,9 +37,7 @@ class BandAssembler:
             raise ValueError("element block wider than the band")
         flat = (a - b)[None, :] * self.n + offsets[:, None] + b[None, :]
         local = a * size + b
-        self._families.append((flat.ravel(), local, "contiguous"))
-        self._all_flat = None
-        return len(self._families) - 1
+        return self._add(flat.ravel(), local, "contiguous")
 
     def add_indexed_family(self, dofs: np.ndarray) -> int:
         """A family of symmetric (m x m) blocks on arbitrary DOFs dofs (K, m), e.g. a triangle's
@@ -43,9 +47,7 @@ class BandAssembler:
         if np.any(np.abs(rows - cols) > self.bandwidth):
             raise ValueError("element block wider than the band")
         flat = ((rows - cols) * self.n + cols)[lower]
-        self._families.append((flat, np.flatnonzero(lower.ravel()), "indexed"))
-        self._all_flat = None
-        return len(self._families) - 1
+        return self._add(flat, np.flatnonzero(lower.ravel()), "indexed")
 
     def add_pair_family(self, row_dofs: np.ndarray, col_dofs: np.ndarray) -> int:
         """A family of blocks C (K, m, p) entering the matrix as C + C^T on rows row_dofs (K, m)
@@ -56,14 +58,12 @@ class BandAssembler:
             raise ValueError("element block wider than the band")
         low, high = np.minimum(rows, cols), np.maximum(rows, cols)
         flat = ((high - low) * self.n + low).ravel()
-        self._families.append((flat, np.where(rows == cols, 2.0, 1.0).ravel(), "pair"))
-        self._all_flat = None
-        return len(self._families) - 1
+        return self._add(flat, np.where(rows == cols, 2.0, 1.0).ravel(), "pair")
 
     def assemble(self, blocks: list[np.ndarray]) -> "SymmetricBanded":
         """Sum the element blocks (one array per family, in the order added) into the band:
         the lower-band entries of all families are gathered into one buffer, one bincount."""
-        if getattr(self, "_all_flat", None) is None:
+        if self._all_flat is None:
             self._all_flat = np.concatenate([f for f, _, _ in self._families])
             self._buffer = np.empty(len(self._all_flat))
         start = 0

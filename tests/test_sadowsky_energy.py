@@ -1,0 +1,162 @@
+"""The regularised discrete Sadowsky energy (Eq. A.5): finite-difference checks of its gradient
+and Hessian at generic deformed, twisted states, and its reduction to the rod's bending energy
+where the twist vanishes.
+
+Conventions as in tests/test_rod_energies.py: q is committed first, so reference frames are
+transported from q; the Hessian matches the symmetrised FD Jacobian of the gradient. DOFs are
+scaled to natural units (h for positions, 1 rad for angles).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from ddg import Strip
+from ddg.energies.rod_bending import bending_energy
+from ddg.energies.rod_curvature import StencilGeometry, material_curvatures
+from ddg.energies.sadowsky import quartic_twist_term, sadowsky_energy
+from ddg.geometry.strip import InputError
+from ddg.models.ribbon import RibbonModel
+from ddg.models.rod import RodModel
+
+# a strip with moderate stiffness contrast (as in test_rod_energies) so no term dominates
+STRIP = Strip(length=0.1, width=0.01, thickness=0.002, young_modulus=1e9, poisson_ratio=0.0)
+SEEDS = (0, 1, 2)
+REL_STEP = 1e-6
+RTOL = 1e-6
+
+
+def rel_err(approx, exact) -> float:
+    return float(np.linalg.norm(np.asarray(approx) - exact) / np.linalg.norm(exact))
+
+
+def dof_scale(model) -> np.ndarray:
+    scale = np.full(model.n_dof, model.centerline.spacing)
+    scale[model.theta_dofs] = 1.0
+    return scale
+
+
+def deformed_twisted_state(model, seed: int) -> np.ndarray:
+    """3-5 committed random perturbations of the rest state (generic 3-D, twisted)."""
+    rng = np.random.default_rng(seed)
+    h = model.centerline.spacing
+    q = model.reset()
+    for _ in range(3 + seed % 3):
+        dq = np.zeros(model.n_dof)
+        dq[model.node_dofs] = 0.085 * h * rng.standard_normal((model.nodes, 3))
+        dq[model.theta_dofs] = 0.3 * rng.standard_normal(model.nodes - 1)
+        q = q + dq
+        model.commit(q)
+    return q
+
+
+def stencil_state(model, q):
+    x = model.positions(q)
+    _, _, m1, m2, m_ref = model.frames(q)
+    geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
+    theta = q[model.theta_dofs]
+    return geom, theta[1:] - theta[:-1] + m_ref
+
+
+def test_quartic_term_partials_match_finite_differences():
+    """Q = tau^4 / (kn^2 + r^2): its five partials against central differences, including kn near 0."""
+    rng = np.random.default_rng(4)
+    kn = np.r_[rng.uniform(-0.3, 0.3, 6), 1e-3, -2e-3]
+    tau = rng.uniform(-0.2, 0.2, kn.size)
+    r = 0.02
+    q, q_k, q_t, q_kk, q_kt, q_tt = quartic_twist_term(kn, tau, r)
+    assert q == pytest.approx(tau**4 / (kn**2 + r**2), rel=1e-14)
+    eps = 1e-7
+    f = lambda a, b: quartic_twist_term(a, b, r)  # noqa: E731
+    assert rel_err((f(kn + eps, tau)[0] - f(kn - eps, tau)[0]) / (2 * eps), q_k) < RTOL
+    assert rel_err((f(kn, tau + eps)[0] - f(kn, tau - eps)[0]) / (2 * eps), q_t) < RTOL
+    assert rel_err((f(kn + eps, tau)[1] - f(kn - eps, tau)[1]) / (2 * eps), q_kk) < RTOL
+    assert rel_err((f(kn, tau + eps)[1] - f(kn, tau - eps)[1]) / (2 * eps), q_kt) < RTOL
+    assert rel_err((f(kn, tau + eps)[2] - f(kn, tau - eps)[2]) / (2 * eps), q_tt) < RTOL
+
+
+@pytest.mark.parametrize("zeta_over_l", (0.5, 10.0))
+@pytest.mark.parametrize("seed", SEEDS)
+def test_ribbon_gradient_and_hessian_match_finite_differences(seed, zeta_over_l):
+    """The assembled ribbon model (stretching + Eq. A.5) at random twisted states: gradient = FD of
+    the energy, Hessian = symmetrised FD Jacobian of the gradient, to 1e-6 relative.
+
+    At zeta / L = 0.5 the regularisation (dl / zeta)^2 is comparable to kn^2 of these states (all
+    terms of Q_kk matter); at 10 the quartic term is close to Sadowsky's tau^4 / kn^2."""
+    model = RibbonModel(STRIP, 9, zeta=zeta_over_l * STRIP.length)
+    q = deformed_twisted_state(model, seed)
+    model.commit(q)
+    geom, tau = stencil_state(model, q)
+    kn, _ = material_curvatures(geom)
+    # the quartic term is a sizeable share of the energy at these states
+    ev = model.evaluate(q)
+    assert ev.parts["sadowsky"] > 0.2 * ev.parts["twisting"]
+    scale = dof_scale(model)
+    n = model.n_dof
+    fd_grad = np.zeros(n)
+    jac = np.zeros((n, n))
+    for i in range(n):
+        step = np.zeros(n)
+        step[i] = REL_STEP * scale[i]
+        ep = model.evaluate(q + step, gradient=True, hessian=False)
+        em = model.evaluate(q - step, gradient=True, hessian=False)
+        fd_grad[i] = (ep.energy - em.energy) / (2 * REL_STEP)
+        jac[:, i] = (ep.gradient - em.gradient) * scale / (2 * REL_STEP)
+    assert rel_err(fd_grad, ev.gradient * scale) < RTOL
+    hess = ev.hessian.to_dense() * np.outer(scale, scale)
+    assert rel_err(0.5 * (jac + jac.T), hess) < RTOL
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_zero_twist_reduces_to_the_rod_bending_energy(seed):
+    """With tau = 0 the energy and gradient of Eq. (A.5) equal the rod's bending energy (Eq. 6b),
+    with EI1 = 0 its out-of-plane part alone; the Hessians differ only by the twist's
+    GJ grad(tau) grad(tau)^T (the quartic term has zero Hessian at tau = 0)."""
+    model = RodModel(STRIP, 12)
+    q = deformed_twisted_state(model, seed)
+    model.commit(q)
+    geom, tau = stencil_state(model, q)
+    zero = np.zeros_like(tau)
+    dl = model.voronoi_lengths
+    s = STRIP
+    for ei1 in (s.geodesic_bending_stiffness, 0.0):
+        e_rod, g_rod, h_rod = bending_energy(geom, dl, s.bending_stiffness, ei1)
+        e, parts, g, h = sadowsky_energy(geom, zero, dl, s.bending_stiffness, ei1, s.twisting_stiffness,
+                                         zeta=1e-3 * s.length)
+        assert np.max(np.abs(e - e_rod)) <= 1e-14 * np.max(e_rod)
+        assert np.all(parts["sadowsky"] == 0.0) and np.all(parts["twisting"] == 0.0)
+        assert rel_err(g, g_rod) < 1e-13
+        from ddg.energies.rod_twist import twist_derivatives
+
+        g_tau, _ = twist_derivatives(geom)
+        k = s.twisting_stiffness / dl
+        twist_outer = k[:, None, None] * g_tau[:, :, None] * g_tau[:, None, :]
+        assert rel_err(h, h_rod + twist_outer) < 1e-13
+    # and at the actual (non-zero) twist the quartic term is what distinguishes the two
+    e, parts, _, _ = sadowsky_energy(geom, tau, dl, s.bending_stiffness, s.geodesic_bending_stiffness,
+                                     s.twisting_stiffness, zeta=s.length)
+    kn, _ = material_curvatures(geom)
+    expected = 0.5 * s.bending_stiffness / dl * tau**4 / (kn**2 + (dl / s.length) ** 2)
+    assert parts["sadowsky"] == pytest.approx(expected, rel=1e-13)
+
+
+def test_sadowsky_limit_with_gj_equal_2ei2():
+    """nu = 0 (GJ = 2 EI2), zeta -> inf: E_i = EI2 / (2 dl) (kn^2 + tau^2)^2 / kn^2 + EI1 kg^2 / (2 dl), Eq. (A.4)."""
+    model = RodModel(STRIP, 12)
+    q = deformed_twisted_state(model, 1)
+    model.commit(q)
+    geom, tau = stencil_state(model, q)
+    dl = model.voronoi_lengths
+    s = STRIP
+    assert s.twisting_stiffness == pytest.approx(2 * s.bending_stiffness, rel=1e-14)
+    e, _, _, _ = sadowsky_energy(geom, tau, dl, s.bending_stiffness, s.geodesic_bending_stiffness,
+                                 s.twisting_stiffness, zeta=1e12)
+    kn, kg = material_curvatures(geom)
+    expected = 0.5 / dl * (s.bending_stiffness * (kn**2 + tau**2) ** 2 / kn**2 + s.geodesic_bending_stiffness * kg**2)
+    assert e == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("bad", (0.0, -1.0, float("inf"), float("nan"), "big"))
+def test_bad_zeta_is_a_one_line_input_error(bad):
+    with pytest.raises(InputError, match="zeta"):
+        RibbonModel(STRIP, 9, zeta=bad)

@@ -1,0 +1,272 @@
+"""The two ways of running the discrete Sadowsky ribbon (paper Appendix A, Fig. A.11).
+
+- "direct" (the paper's Direct-Sadowsky): the ribbon itself is followed from the flat strip
+  through compression and shear by the same continuation as the rod (ddg.solve.continuation,
+  branch switching and stability checks included).
+- "rod" (the paper's DAR-Sadowsky): the rod (DAR) is followed along its own stable path; at each
+  recorded step its converged state (DOFs and reference frames, which the two models share)
+  starts an energy descent under the ribbon's energy (Eq. A.5).
+
+`pitchfork_analysis` explains why the direct ribbon misses dW1: the ribbon's lambda_min at the
+rod's pitchfork, and the energy barrier between the ribbon's U state and the US state reached
+from the rod, concentrated in the quartic twist term at the inflection points.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .api import (CENTERLINE_STATIONS, DEFAULT_RESOLUTION, SimulationResult, _fill_thresholds, _Progress,
+                  _track_brackets, base_summary)
+from .geometry.frames import cross, parallel_transport, rowdot
+from .geometry.strip import InputError, LoadingProtocol, Strip
+from .io import write_path_csv
+from .models.ribbon import RibbonModel
+from .models.rod import RodModel
+from .observables import observe, resolved_up_to
+from .solve.continuation import ContinuationFailure, ContinuationOptions, PathFollower, State
+from .solve.newton import newton
+from .solve.stability import lowest_modes
+
+RIBBON_INITS = ("direct", "rod")
+
+
+@dataclass
+class RibbonResult(SimulationResult):
+    """A ribbon run; for init="rod" also the rod's own rows (written to rod_path.csv)."""
+    rod_rows: list = field(default_factory=list)
+
+    def write(self, out) -> None:
+        super().write(out)
+        if self.rod_rows:
+            write_path_csv(Path(out) / "rod_path.csv", self.rod_rows)
+
+
+def relax_from(model, source_model, source_state: State, options: ContinuationOptions) -> State:
+    """Energy descent under `model` from a converged state of `source_model` (same DOF layout),
+    with the source's reference frames; a stable equilibrium of `model` or ContinuationFailure."""
+    model.restore_frames(source_model.save_frames())
+    result = newton(model, source_state.q, options.newton, minimize=True)
+    if not result.converged:
+        L = model.strip.length
+        raise ContinuationFailure(f"the ribbon did not relax from the rod state at dL/L = {source_state.compression / L:.6g}, "
+                                  f"dW/L = {source_state.shear / L:.6g} ({result.message or 'Newton did not converge'})")
+    model.commit(result.q, result.evaluation)
+    return State(result.q, result.evaluation, source_state.compression, source_state.shear,
+                 bool(result.positive_definite), result.iterations)
+
+
+def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", zeta: float | None = None,
+               resolution: int | None = None, out=None, options: ContinuationOptions | None = None,
+               thresholds: bool = True, progress: bool = False) -> RibbonResult:
+    """The ribbon (Eq. A.5) through the two-stage protocol, started "direct" or from the "rod".
+
+    Rows, summary and centerlines as ddg.simulate (path.csv, summary.json, centerline.csv);
+    summary adds ribbon_init, zeta, zeta_over_L. init="direct" locates dW1 from the ribbon's own
+    stability where its path leaves U (None if it never does); init="rod" reports the rod's
+    thresholds as rod_dW1_over_L, rod_dW2_over_L and writes the rod's rows to rod_path.csv.
+    """
+    if init not in RIBBON_INITS:
+        raise InputError(f"ribbon init = {init!r} is not available; choose one of {list(RIBBON_INITS)}")
+    if not isinstance(strip, Strip) or not isinstance(protocol, LoadingProtocol):
+        raise InputError("run_ribbon needs a ddg.Strip and a ddg.LoadingProtocol")
+    resolution = DEFAULT_RESOLUTION["rod"] if resolution is None else resolution
+    options = options or ContinuationOptions()
+    ribbon = RibbonModel(strip, resolution, zeta=zeta)
+    rod = RodModel(strip, resolution) if init == "rod" else None
+    driver = rod if rod is not None else ribbon
+    follower = PathFollower(driver, options)
+    L = strip.length
+    dL = protocol.compression_ratio * L
+    dW = protocol.shear_sign * protocol.resolved_shear_ratio(strip) * L
+    summary = base_summary("ribbon", strip, protocol, resolution, ribbon)
+    summary.update(ribbon_init=init, zeta=ribbon.zeta, zeta_over_L=ribbon.zeta / L)
+    rows, rod_rows, centerlines = [], [], []
+    brackets = {"last_u": None, "first_us": None, "last_us": None, "first_s": None}
+    bar = _Progress(protocol.compression_steps + protocol.shear_steps + 1, progress)
+    relax_iterations = 0
+    t0 = time.perf_counter()
+    state = None
+
+    def record(stage, driven):
+        nonlocal state, relax_iterations
+        if rod is not None:
+            rod_rows.append(observe(rod, driven, stage, options.eigenvalues))
+            state = relax_from(ribbon, rod, driven, options)
+            relax_iterations += state.iterations
+        else:
+            state = driven
+        row = observe(ribbon, state, stage, options.eigenvalues)
+        rows.append(row)
+        if stage == "shear" and thresholds and rod is None:
+            _track_brackets(brackets, ribbon, state, row["phase"])
+        centerlines.append(ribbon.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
+        bar.update(f"{stage} dL/L={row['dL_over_L']:.4f} dW/L={row['dW_over_L']:.4f}")
+
+    driven = None
+    try:
+        driven = follower.rest()
+        record("compression", driven)
+        for k in range(1, protocol.compression_steps + 1):
+            target = dL * k / protocol.compression_steps
+            driven = follower.start_compression(target) if k == 1 else follower.advance(driven, target, 0.0)
+            record("compression", driven)
+        summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
+        for k in range(1, protocol.shear_steps + 1 if dW != 0.0 else 1):
+            driven = follower.advance(driven, dL, dW * k / protocol.shear_steps)
+            record("shear", driven)
+        summary["converged"] = True
+        summary["message"] = "path complete"
+    except ContinuationFailure as exc:
+        summary["message"] = str(exc)
+    finally:
+        bar.close()
+        if thresholds and options.eigenvalues and state is not None and rod is None:
+            _fill_thresholds(summary, ribbon, options, brackets)
+        summary["newton_iterations"] = follower.newton_iterations + relax_iterations
+        summary["wall_time_s"] = time.perf_counter() - t0
+        summary["recorded_steps"] = len(rows)
+        summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
+        result = RibbonResult(rows, summary, state, ribbon, centerlines, rod_rows=rod_rows)
+        if out is not None:
+            result.write(out)
+    return result
+
+
+# ---------------------------------------------------------------------- why direct misses dW1
+def same_state_in_frames(model, q_from: np.ndarray, frames_from, q: np.ndarray, frames) -> np.ndarray:
+    """q (positions, twist angles in the reference frames `frames`) rewritten with twist angles
+    measured from the reference frames `frames_from` of state q_from transported to q's
+    tangents: the same material frames, so states of two runs can be interpolated."""
+    saved = model.save_frames()
+    try:
+        model.restore_frames(frames)
+        _, _, m1, _, _ = model.frames(q)
+        model.restore_frames(frames_from)
+        t, d1, _, _, _ = model.frames(q)
+    finally:
+        model.restore_frames(saved)
+    d2 = cross(t, d1)
+    out = q.copy()
+    theta_from = q_from[model.theta_dofs]
+    angle = np.arctan2(rowdot(m1, d2), rowdot(m1, d1))
+    # the branch of the angle closest to the source's twist angles
+    out[model.theta_dofs] = theta_from + np.remainder(angle - theta_from + np.pi, 2 * np.pi) - np.pi
+    return out
+
+
+def straight_line_barrier(model, a: State, frames_a, b: State, frames_b, samples: int = 41) -> dict:
+    """Energy along the straight line in DOF space from equilibrium a to equilibrium b (b's twist
+    angles re-expressed in a's frames): an upper bound on the barrier between them. Returns the
+    fractions t, energies E(t) - E(a) and the quartic (Sadowsky) share of the energy change, and
+    the node (s/L) whose quartic term rises most at the top of the path."""
+    qb = same_state_in_frames(model, a.q, frames_a, b.q, frames_b)
+    saved = model.save_frames()
+    t = np.linspace(0.0, 1.0, samples)
+    energy, quartic = np.zeros(samples), np.zeros(samples)
+    try:
+        model.restore_frames(frames_a)
+        for k, tk in enumerate(t):
+            ev = model.evaluate((1 - tk) * a.q + tk * qb, gradient=False, hessian=False)
+            energy[k] = ev.energy
+            quartic[k] = ev.parts.get("sadowsky", 0.0)
+        top = int(np.argmax(energy))
+        per_node = _quartic_per_node(model, (1 - t[top]) * a.q + t[top] * qb) - _quartic_per_node(model, a.q)
+    finally:
+        model.restore_frames(saved)
+    s_nodes = model.centerline.node_arclength[1:-1] / model.strip.length
+    return {"t": t, "energy": energy - energy[0], "quartic": quartic - quartic[0], "top": top,
+            "barrier": float(energy[top] - energy[0]), "end_difference": float(energy[-1] - energy[0]),
+            "peak_node_s_over_L": float(s_nodes[int(np.argmax(per_node))])}
+
+
+def _quartic_per_node(model, q):
+    from .energies.rod_curvature import StencilGeometry
+    from .energies.sadowsky import sadowsky_energy
+
+    x = q[model.node_dofs]
+    _, _, m1, m2, m_ref = model.frames(q)
+    geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
+    theta = q[model.theta_dofs]
+    s = model.strip
+    _, parts, _, _ = sadowsky_energy(geom, theta[1:] - theta[:-1] + m_ref, model.voronoi_lengths, s.bending_stiffness,
+                                     s.geodesic_bending_stiffness, s.twisting_stiffness, model.zeta, gradient=False)
+    return parts["sadowsky"]
+
+
+def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float | None = None,
+                       resolution: int = 101, beyond: float = 0.05, options: ContinuationOptions | None = None) -> dict:
+    """Why the direct ribbon misses dW1 (all shears in units of L, energies in EI2 / L):
+
+    - rod_dW1: the rod's pitchfork (lambda_min = 0 on its U branch, ddg.solve.thresholds);
+    - rod_lambda_min / ribbon_lambda_min at rod_dW1: normalised lowest eigenvalues of both
+      models' U states there (the ribbon's U branch followed directly from the flat strip);
+    - at dW = rod_dW1 + beyond: the ribbon's U state (direct) and its US state (relaxed from the
+      rod's US+), their energies, H_mid, and the straight-line barrier between them.
+    """
+    options = options or ContinuationOptions()
+    L = strip.length
+    protocol = LoadingProtocol(compression_ratio, shear_ratio=None, compression_steps=20, shear_steps=40)
+    dL = compression_ratio * L
+    unit = strip.bending_stiffness / L
+
+    def compressed(model):
+        follower = PathFollower(model, options)
+        state = follower.rest()
+        for k in range(1, protocol.compression_steps + 1):
+            target = dL * k / protocol.compression_steps
+            state = follower.start_compression(target) if k == 1 else follower.advance(state, target, 0.0)
+        return follower, state
+
+    rod, ribbon = RodModel(strip, resolution), RibbonModel(strip, resolution, zeta=zeta)
+    # the rod's pitchfork along its U branch
+    from .solve.thresholds import Snapshot, locate_sign_change
+
+    rod_follow, rod_state = compressed(rod)
+    rod_follow.options = ContinuationOptions(**{**options.__dict__, "branch_switching": False})
+    lam = lambda m, s: float(lowest_modes(m, s.evaluation.hessian, 1)[0])  # noqa: E731
+    step, last = 0.02 * L, Snapshot.take(rod, rod_state)
+    while lam(rod, rod_state) > 0 and rod_state.shear < 0.6 * L:
+        last = Snapshot.take(rod, rod_state)
+        rod_state = rod_follow.advance(rod_state, dL, rod_state.shear + step)
+    dw1 = locate_sign_change(rod, rod_follow.options, last, rod_state.shear, 1e-4 * L)
+    rod.restore_frames(last.frames)
+    rod_at = PathFollower(rod, rod_follow.options).advance(last.state, dL, dw1)
+    # the direct ribbon along its own path to the same shear
+    rib_follow, rib_state = compressed(ribbon)
+    for k in range(1, 11):
+        rib_state = rib_follow.advance(rib_state, dL, dw1 * k / 10)
+    rib_lam = lam(ribbon, rib_state)
+    rib_phase_at = observe(ribbon, rib_state, "shear")["phase"]
+    # beyond the pitchfork: ribbon U (direct) against ribbon US (from the rod's US+)
+    target = dw1 + beyond * L
+    rib_u = rib_follow.advance(rib_state, dL, target)
+    frames_u = ribbon.save_frames()
+    rod_switch = PathFollower(rod, options)
+    rod_us = rod_switch.advance(rod_at, dL, target)
+    rib_us = relax_from(ribbon, rod, rod_us, options)
+    frames_us = ribbon.save_frames()
+    barrier = straight_line_barrier(ribbon, rib_u, frames_u, rib_us, frames_us)
+    ribbon.restore_frames(frames_u)
+    row_u = observe(ribbon, rib_u, "shear")
+    ribbon.restore_frames(frames_us)
+    row_us = observe(ribbon, rib_us, "shear")
+    return {
+        "rod_dW1_over_L": dw1 / L,
+        "rod_lambda_min_at_rod_dW1": lam(rod, rod_at),
+        "ribbon_lambda_min_at_rod_dW1": rib_lam,
+        "ribbon_phase_at_rod_dW1": rib_phase_at,
+        "dW_over_L_beyond": target / L,
+        "ribbon_U": {"phase": row_u["phase"], "H_mid_over_L": row_u["H_mid_over_L"], "lambda_min": row_u["lambda_min"],
+                     "energy": rib_u.evaluation.energy / unit},
+        "ribbon_from_rod": {"phase": row_us["phase"], "H_mid_over_L": row_us["H_mid_over_L"],
+                            "lambda_min": row_us["lambda_min"], "energy": rib_us.evaluation.energy / unit},
+        "rod_H_mid_over_L_beyond": float(rod.midpoint(rod_us.q)[2]) / L,
+        "straight_line_barrier": barrier["barrier"] / unit,
+        "straight_line_barrier_quartic_share": float(barrier["quartic"][barrier["top"]] / barrier["energy"][barrier["top"]])
+        if barrier["energy"][barrier["top"]] > 0 else float("nan"),
+        "barrier_peak_node_s_over_L": barrier["peak_node_s_over_L"],
+    }

@@ -15,7 +15,7 @@ from .io import write_centerline_csv, write_path_csv, write_summary_json
 from .observables import observe, resolved_up_to
 from .solve.continuation import ContinuationFailure, ContinuationOptions, PathFollower
 
-DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000}
+DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "ribbon": 101}  # ribbon: M not a multiple of 4, see RibbonModel
 
 
 #: Stations along the centerline exported per recorded step (centerline.csv).
@@ -56,9 +56,10 @@ def _frame_writer(model, directory: Path):
 
 def _model_class(name: str):
     from .models.plate import PlateModel
+    from .models.ribbon import RibbonModel
     from .models.rod import RodModel
 
-    models = {"rod": RodModel, "plate": PlateModel}
+    models = {"rod": RodModel, "plate": PlateModel, "ribbon": RibbonModel}
     if name not in models:
         raise InputError(f"model = {name!r} is not available; choose one of {sorted(models)}")
     return models[name]
@@ -71,6 +72,7 @@ class SimulationResult:
     final_state: object = None
     model: object = None
     centerlines: list = field(default_factory=list)  # per recorded row: (stations, 3) positions of w = 0
+    branch_rows: list = field(default_factory=list)  # rows of branches.csv (every branch, stable or not)
 
     @property
     def converged(self) -> bool:
@@ -85,6 +87,8 @@ class SimulationResult:
         write_path_csv(out / "path.csv", self.rows)
         if self.centerlines:
             write_centerline_csv(out / "centerline.csv", self.rows, self.centerlines, self.strip_length)
+        if self.branch_rows:
+            write_path_csv(out / "branches.csv", self.branch_rows, leading=("branch",))
         write_summary_json(out / "summary.json", self.summary)
 
     @property
@@ -139,6 +143,31 @@ def _fill_thresholds(summary: dict, model, options, brackets: dict) -> None:
     summary["threshold_wall_time_s"] = time.perf_counter() - t0
 
 
+def _trace_branches(summary: dict, model, options, compressed, shear_max: float, brackets: dict) -> list[dict]:
+    """Every branch of the shear stage by pseudo-arclength (ddg.solve.branches); its rows."""
+    from .solve.branches import trace_branches
+
+    t0 = time.perf_counter()
+    saved = model.save_frames()
+    try:
+        diagram = trace_branches(model, options, compressed, shear_max, brackets["first_s"])
+    finally:
+        model.restore_frames(saved)
+    summary["branches"] = diagram.summary(model.strip.length)
+    summary["branches_newton_iterations"] = diagram.newton_iterations
+    summary["branches_wall_time_s"] = time.perf_counter() - t0
+    return diagram.rows()
+
+
+def _distinct(values: list[float], tolerance: float) -> list[float]:
+    """values without the ones within tolerance of an earlier one (a fold met by several substeps)."""
+    out: list[float] = []
+    for v in values:
+        if all(abs(v - w) > tolerance for w in out):
+            out.append(v)
+    return out
+
+
 def versions() -> dict:
     from . import __version__
 
@@ -163,6 +192,9 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
         "dW2_over_L": None,
         "dW2_S_stable_over_L": None,
         "threshold_wall_time_s": None,
+        "branches": None,
+        "branches_wall_time_s": None,
+        "folds_dW_over_L": [],
         "n_dof": model.n_dof,
         "n_free_dof": int(np.arange(model.n_dof)[model.free].size),
         "newton_iterations": 0,
@@ -188,6 +220,7 @@ def simulate(
     mesh=None,
     frames: bool = False,
     thresholds: bool = True,
+    branches: bool = True,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
@@ -200,6 +233,11 @@ def simulate(
     recorded step and out/frames/frames.pvd (ParaView). mesh: see make_model. thresholds=True
     locates dW1 and dW2 from stability after the path (ddg.solve.thresholds; summary keys
     dW1_over_L, dW2_over_L, dW2_S_stable_over_L) when the recorded path brackets them.
+    branches=True (with thresholds) then traces every branch of the shear stage by
+    pseudo-arclength continuation, stable and unstable parts, through folds (U, US+, US-, and
+    S from the first S state of the path; ddg.solve.branches): rows in result.branch_rows and
+    out/branches.csv (path.csv's columns after a `branch` column), per-branch summary under
+    the summary key `branches`.
     """
     if solver not in ("static", "dynamic"):
         raise InputError(f"solver = {solver!r} is not available; choose 'static' or 'dynamic'")
@@ -239,6 +277,8 @@ def simulate(
     state = None
 
     brackets = {"last_u": None, "first_us": None, "last_us": None, "first_s": None}
+    compressed = None
+    branch_rows: list[dict] = []
 
     def record(stage):
         row = observe(instance, state, stage, options.eigenvalues)
@@ -259,6 +299,9 @@ def simulate(
             state = follower.start_compression(target) if k == 1 else follower.advance(state, target, 0.0)
             record("compression")
         summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
+        from .solve.thresholds import Snapshot
+
+        compressed = Snapshot.take(instance, state)
         for k in range(1, protocol.shear_steps + 1 if dW != 0.0 else 1):
             state = follower.advance(state, dL, dW * k / protocol.shear_steps)
             record("shear")
@@ -271,15 +314,18 @@ def simulate(
         raise
     finally:
         progress_bar.close()
-        if thresholds and options.eigenvalues and state is not None:
+        if thresholds and options.eigenvalues and state is not None and summary["message"] != "interrupted":
             _fill_thresholds(summary, instance, options, brackets)
+            if branches and compressed is not None and dW != 0.0:
+                branch_rows = _trace_branches(summary, instance, options, compressed, dW, brackets)
         summary["newton_iterations"] = follower.newton_iterations
+        summary["folds_dW_over_L"] = _distinct([abs(f) / L for f in follower.folds], 1e-4)
         summary["wall_time_s"] = time.perf_counter() - t0
         summary["recorded_steps"] = len(rows)
         summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
         if writer is not None:
             writer.close()
-        result = SimulationResult(rows, summary, state, instance, centerlines)
+        result = SimulationResult(rows, summary, state, instance, centerlines, branch_rows)
         if out is not None:
             result.write(out)
     return result

@@ -38,8 +38,9 @@ def _format(value):
     return value
 
 
-def write_path_csv(path: Path, rows: list[dict]) -> None:
-    columns = list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if rows and c in rows[0]]
+def write_path_csv(path: Path, rows: list[dict], leading: tuple[str, ...] = ()) -> None:
+    """path.csv (and branches.csv, with leading=("branch",)): the contract columns, then the extras."""
+    columns = list(leading) + list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if rows and c in rows[0]]
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(columns)

@@ -19,6 +19,16 @@ from .newton import NewtonOptions, newton
 from .stability import lowest_modes
 
 
+#: The largest push off an unstable state (relative to L) tried before giving up on it.
+MAX_KICK = 0.05
+
+
+def _phase_of(model, state) -> str:
+    from ..observables import phase_label
+
+    return phase_label(model, state.q, state.compression, state.shear)
+
+
 class ContinuationFailure(RuntimeError):
     """The path could not be continued; the message says where."""
 
@@ -46,6 +56,7 @@ class State:
     stable: bool
     iterations: int = 0
     branch_switched: bool = False
+    frames: object = None  # the model's reference frames at this state (rod), where kept
 
 
 class PathFollower:
@@ -56,6 +67,8 @@ class PathFollower:
         self.newton_iterations = 0
         self._easy_streak = 0
         self._history: list[tuple[np.ndarray, np.ndarray]] = []  # (load, q) of the last equilibria on this branch
+        self._fold_tried_at = None
+        self.folds: list[float] = []  # dW (m) of the limit points met (pseudo-arclength turned back there)
 
     # ------------------------------------------------------------------ predictors
     def _remember(self, state: State, restart: bool = False) -> None:
@@ -136,6 +149,11 @@ class PathFollower:
             # near singular points (thresholds) Newton converges only linearly: allow it more iterations
             hard = self.substep <= self.options.jump_substep
             new = self._step(state, *load, patient=hard)
+            if new is None and hard and load[0] == state.compression and self._fold_tried_at is not state:
+                self._fold_tried_at = state  # once per state: a second failure is not a fold
+                # Newton stalls near a limit point of dW: pseudo-arclength goes round it, or past
+                # the hard spot to the target (then new is the equilibrium at the target)
+                new = self._across_fold(state, *load)
             if new is None and self.options.branch_switching and hard:
                 # the branch has ended (a fold): let the strip snap to the nearest stable state
                 new = self._jump(state, *load)
@@ -147,10 +165,14 @@ class PathFollower:
                     limit = strip.shear_limit(state.compression) if state.compression > 0 else float("nan")
                     reach = (f"; that is {100 * abs(state.shear) / limit:.2f} % of dW_max/L = {limit / self._length:.4g} "
                              "(Eq. B.1)") if state.shear != 0.0 and limit > 0 else ""
+                    fold = ""
+                    if self.folds and abs(self.folds[-1] - state.shear) < abs(target[1] - start[1]) + 1e-12:
+                        fold = (f"; the branch folds at dW/L = {self.folds[-1] / self._length:.6g} (a limit point: "
+                                "beyond it the branch turns back unstable; see branches.csv)")
                     raise ContinuationFailure(
                         f"Newton failed to converge beyond dL/L = {state.compression / self._length:.6g}, "
                         f"dW/L = {state.shear / self._length:.6g}{reach} (substep below {self.options.min_substep:g} "
-                        "of a recorded interval)"
+                        f"of a recorded interval){fold}"
                     )
                 continue
             iterations += new.iterations
@@ -212,6 +234,106 @@ class PathFollower:
                 model.restore_frames(saved)
         return new
 
+    def _across_fold(self, state: State, compression: float, shear: float) -> State | None:
+        """Pseudo-arclength continuation from `state` towards dW = shear. If the branch gets
+        there, the equilibrium at `shear` (Newton from the interpolated arclength states); if it
+        turns back first (a fold), None, with the fold's dW appended to self.folds."""
+        from .arclength import ArclengthOptions, ArclengthTracer
+
+        model = self.model
+        saved = model.save_frames()
+        direction = 1.0 if shear >= state.shear else -1.0
+        span = abs(shear - state.shear) / self._length
+        tracer = ArclengthTracer(model, self.options.newton,
+                                 ArclengthOptions(initial_step=span / 4, max_step=max(span, 1e-4), max_points=40))
+        points, _ = tracer.trace(state, direction,
+                                 stop=lambda s: (s.shear - shear) * direction >= 0 or (s.shear - state.shear) * direction < 0)
+        self.newton_iterations += tracer.newton_iterations
+        shears = np.array([state.shear] + [p.shear for p in points])
+        if points and (points[-1].shear - shear) * direction >= 0:
+            before, after = ([state] + points)[-2:]
+            weight = (shear - before.shear) / (after.shear - before.shear)
+            model.restore_frames(before.frames if before.frames is not None else saved)
+            q = (1 - weight) * before.q + weight * after.q
+            q[model.constrained] = model.clamp_values(compression, shear)
+            result = newton(model, q, self.options.newton)
+            self.newton_iterations += result.iterations
+            if result.converged:
+                new = State(result.q, result.evaluation, compression, shear, bool(result.positive_definite),
+                            result.iterations + tracer.newton_iterations)
+                if new.stable or not self.options.branch_switching:
+                    return new
+                new = self._ensure_stable(new, 0)
+                if new is not None:
+                    return new
+        elif points:
+            self.folds.append(float(shears[np.argmax(shears * direction)]))
+            if self.options.branch_switching:
+                snapped = self._snap_past_fold(points[-1], compression, shear)
+                if snapped is not None:
+                    return snapped
+        model.restore_frames(saved)
+        return None
+
+    def _snap_past_fold(self, turned: State, compression: float, shear: float) -> State | None:
+        """Where an asymmetric (US) branch folds, follow its unstable part on to the symmetric
+        branch it meets (U or S, a pitchfork of that branch), then that branch to dW = shear:
+        the state the strip snaps to if it is stable there (None otherwise). Energy descent
+        (_jump) reaches the same state, but on a plate it slides slowly along the soft valley."""
+        from .arclength import ArclengthTracer
+        from .branches import _asymmetry, _crosses
+
+        model = self.model
+        if not _phase_of(model, turned).startswith("US"):
+            return None
+        model.restore_frames(turned.frames)
+        tracer = ArclengthTracer(model, self.options.newton)
+        direction = -1.0 if shear >= turned.shear else 1.0
+        stop_s = _crosses(lambda s: model.midpoint(s.q)[2], turned, "S", model)
+        stop_u = _crosses(lambda s: _asymmetry(model, s), turned, "U", model)
+
+        def stop(s):
+            a, b = stop_s(s), stop_u(s)
+            return True if (a is True or b is True) else ("drop" if (a or b) else False)
+
+        points, why = tracer.trace(turned, direction, stop=stop, max_points=60)
+        self.newton_iterations += tracer.newton_iterations
+        if why != "stop condition" or not points:
+            return None
+        junction = points[-1]
+        if _phase_of(model, junction).startswith("US"):
+            # the tracer stepped through the junction onto the mirror branch: the symmetric state
+            # lies between (the two sides are mirror images, so interpolating where the measure
+            # vanishes is within O(step^2) of it); converge it at its dW on the symmetric branch
+            after = tracer.dropped
+            if after is None:
+                return None
+            measure = (lambda s: model.midpoint(s.q)[2]) if stop_s(after) == "drop" else (lambda s: _asymmetry(model, s))
+            ma, mb = measure(junction), measure(after)
+            weight = ma / (ma - mb)
+            q = (1 - weight) * junction.q + weight * after.q
+            between = junction.shear + weight * (after.shear - junction.shear)
+            model.restore_frames(junction.frames)
+            q[model.constrained] = model.clamp_values(compression, between)
+            result = newton(model, q, self.options.newton)
+            self.newton_iterations += result.iterations
+            if not result.converged or _phase_of(model, State(result.q, None, compression, between, False)).startswith("US"):
+                return None
+            model.commit(result.q, result.evaluation)
+            junction = State(result.q, result.evaluation, compression, between, bool(result.positive_definite))
+        follower = PathFollower(model, replace(self.options, branch_switching=False))
+        follower._remember(junction, restart=True)
+        try:
+            new = follower.advance(junction, compression, shear)
+        except ContinuationFailure:
+            return None
+        finally:
+            self.newton_iterations += follower.newton_iterations
+        if not new.stable:
+            return None
+        new.branch_switched = True
+        return new
+
     def _jump(self, state: State, compression: float, shear: float) -> State | None:
         """Quasi-static snap: descend in energy from the predicted state at the new load."""
         model = self.model
@@ -242,7 +364,11 @@ class PathFollower:
         sign = 1.0 if model.mode_sign(mode, direction) >= 0 else -1.0
         if direction == 0:
             sign *= self.options.branch_sign
-        for kick in (self.options.kick, 10 * self.options.kick, 0.1 * self.options.kick):
+        # close to a pitchfork lambda_min is small, and a push of 1e-5 L may leave a residual below
+        # Newton's tolerance at the saddle itself: grow the push until the descent gets away
+        k = self.options.kick
+        pushes = [k] + [k * 10**j for j in range(1, 4) if k * 10**j <= MAX_KICK] + [0.1 * k]
+        for kick in pushes:
             saved = model.save_frames()
             q = state.q + sign * kick * self._length * mode
             model.commit(q)

@@ -1,0 +1,148 @@
+"""The bifurcation diagram of the shear stage: every branch, stable and unstable parts alike.
+
+After the recorded path (which follows the stable branch), the branches are traced by
+pseudo-arclength continuation in dW (ddg.solve.arclength), so folds are passed, not jumped:
+
+- U: the symmetric branch from the compressed state, without branch switching, to dW_max; it
+  turns unstable at the pitchfork dW1 (lambda_min < 0).
+- US+ and US-: from the first unstable U state past dW1, a push along plus and minus the
+  critical mode and an energy descent give one stable state on each new branch; each is traced
+  backwards to the pitchfork (until the shape is U again) and forwards until it reaches the
+  point-symmetric S branch (the shape is S) or dW_max. Where US folds (the wide and the narrow
+  plate), the tracer goes round the fold and follows the unstable part back to S.
+- S+ (S- with branch_sign = -1): from the first S state of the recorded path, backwards as far as
+  the branch goes and forwards to dW_max.
+
+The two US branches are mirror images (the scene is invariant under the half turn about the
+vertical axis through the midpoint between the clamps), which the tests check point by point.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from .arclength import ArclengthOptions, ArclengthTracer
+from .continuation import ContinuationOptions, PathFollower, State
+from .thresholds import Snapshot
+
+
+@dataclass
+class Branch:
+    name: str
+    states: list[State] = field(default_factory=list)
+    rows: list[dict] = field(default_factory=list)
+    end: str = ""
+
+    def folds(self) -> list[float]:
+        """dW (m) at the limit points: where the branch turns back in dW."""
+        shear = np.array([s.shear for s in self.states])
+        if shear.size < 3:
+            return []
+        step = np.diff(shear)
+        turns = np.nonzero(step[:-1] * step[1:] < 0)[0] + 1
+        return [float(shear[i]) for i in turns]
+
+
+@dataclass
+class BifurcationDiagram:
+    branches: list[Branch]
+    newton_iterations: int
+
+    def rows(self) -> list[dict]:
+        return [row for branch in self.branches for row in branch.rows]
+
+    def summary(self, length: float) -> dict:
+        """Per branch: points, dW/L range, folds (dW/L), how it ended; for summary.json."""
+        out = {}
+        for b in self.branches:
+            shear = [s.shear / length for s in b.states]
+            out[b.name] = {"points": len(b.states),
+                           "dW_over_L_range": [min(shear), max(shear)] if shear else None,
+                           "folds_dW_over_L": [f / length for f in b.folds()],
+                           "stable_points": int(sum(r["stable"] for r in b.rows)),
+                           "end": b.end}
+        return out
+
+
+def _asymmetry(model, state: State) -> float:
+    """Height of the highest point of the first half of the centerline minus that of the second:
+    zero on U and S, of the branch's sign on US+ / US-."""
+    z = model.centerline_positions(state.q, 101)[0][:, 2]
+    return float(np.max(z[:50]) - np.max(z[51:]))
+
+
+def _crosses(measure, seed: State, phase: str, model):
+    """Stop condition: the state has `phase` (U or S: the junction, kept), or `measure` changed
+    sign from the seed's (the tracer went through the junction onto the mirror branch: dropped)."""
+    reference = measure(seed)
+
+    def stop(state: State):
+        if _phase(model, state).rstrip("+-") == phase:
+            return True
+        return "drop" if measure(state) * reference < 0 else False
+
+    return stop
+
+
+def _phase(model, state: State) -> str:
+    from ..observables import phase_label
+
+    return phase_label(model, state.q, state.compression, state.shear)
+
+
+def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, shear_max: float,
+                   first_s: Snapshot | None = None,
+                   arclength: ArclengthOptions | None = None) -> "BifurcationDiagram":
+    """Trace U, US+, US- (and S from first_s, a recorded S state) at the compression of the
+    recorded state `compressed`, for shear between 0 and shear_max (signed)."""
+    from ..observables import observe
+
+    direction = 1.0 if shear_max >= 0 else -1.0
+    lo, hi = sorted((0.0, shear_max))
+    in_range = (lo - 1e-12, hi + 1e-12)
+    tracer = ArclengthTracer(model, options.newton, arclength)
+    branches: list[Branch] = []
+
+    def finish(branch: Branch, states: list[State]) -> Branch:
+        branch.states = states
+        branch.rows = [{"branch": branch.name, **observe(model, s, "shear", True)} for s in states]
+        branches.append(branch)
+        return branch
+
+    # U: the symmetric branch, stable up to dW1
+    model.restore_frames(compressed.frames)
+    u_states, why = tracer.trace(compressed.state, direction, shear_range=in_range)
+    u = finish(Branch("U", end=why), [compressed.state] + u_states)
+    lam = np.array([r["lambda_min"] for r in u.rows])
+    crossing = np.nonzero((lam[:-1] > 0) & (lam[1:] <= 0))[0]
+    if crossing.size:
+        k = int(crossing[0]) + 1
+        past = u.states[k]
+        past_frames = past.frames
+        for sign, name in ((1, "US+"), (-1, "US-")):
+            model.restore_frames(past_frames)
+            switcher = PathFollower(model, replace(options, branch_switching=True, branch_sign=sign))
+            seed = switcher._ensure_stable(replace(past, stable=False), 0)
+            if seed is None:
+                branches.append(Branch(name, end="no stable state found next to the pitchfork"))
+                continue
+            seed_frames = model.save_frames()
+            # the US branches join U at dW1 and S at the S branch's own pitchfork, and the tracer
+            # would go through either junction onto the mirror branch: stop where the shape
+            # crosses the symmetric one (the asymmetry, resp. H_mid, changes sign)
+            back, _ = tracer.trace(seed, -direction, shear_range=in_range, max_points=60, initial_step=5e-4,
+                                   stop=_crosses(lambda s: _asymmetry(model, s), seed, "U", model))
+            model.restore_frames(seed_frames)
+            ahead, why = tracer.trace(seed, direction, shear_range=in_range,
+                                      stop=_crosses(lambda s: model.midpoint(s.q)[2], seed, "S", model))
+            tracer.newton_iterations += switcher.newton_iterations
+            finish(Branch(name, end=why), back[::-1] + [seed] + ahead)
+    if first_s is not None:
+        state, frames = first_s.state, first_s.frames
+        model.restore_frames(frames)
+        back, _ = tracer.trace(state, -direction, shear_range=in_range, max_points=80)
+        model.restore_frames(frames)
+        ahead, why = tracer.trace(state, direction, shear_range=in_range)
+        finish(Branch(_phase(model, state) or "S", end=why), back[::-1] + [state] + ahead)
+    return BifurcationDiagram(branches, tracer.newton_iterations)

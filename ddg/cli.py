@@ -26,8 +26,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m ddg", description="DDG solvers for pre-buckled strips under shear.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sim = sub.add_parser("simulate", help="compress by dL, then shear by dW; write path.csv and summary.json")
-    sim.add_argument("--model", default="rod", choices=("rod", "plate"),
-                     help="rod (DAR, default) or plate (DEP on a triangle mesh)")
+    sim.add_argument("--model", default="rod", choices=("rod", "plate", "ribbon"),
+                     help="rod (DAR, default), plate (DEP on a triangle mesh) or ribbon (Sadowsky, Eq. A.5)")
+    sim.add_argument("--zeta", type=float, default=None,
+                     help="ribbon: regularisation length zeta of Eq. (A.5) in metres (default 1e4 L)")
+    sim.add_argument("--ribbon-init", choices=("direct", "rod"), default=None,
+                     help="ribbon: 'direct' from the flat strip (default) or 'rod': relax each rod equilibrium")
     sim.add_argument("--width-ratio", type=float, default=0.05, help="W/L (default 0.05)")
     sim.add_argument("--compression-ratio", type=float, default=0.5, help="dL/L (default 0.5)")
     sim.add_argument("--shear-ratio", type=float, default=None, help="largest dW/L (default dW_max/L, Eq. B.1)")
@@ -49,6 +53,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="at the pitchfork follow US+ and then S+ (default) or US- and S-")
     sim.add_argument("--no-thresholds", action="store_true",
                      help="skip locating dW1 and dW2 from stability after the path (summary keys stay null)")
+    sim.add_argument("--no-branches", action="store_true",
+                     help="skip tracing every branch (U, US+, US-, S) by pseudo-arclength after the path "
+                          "(OUT/branches.csv)")
     sim.add_argument("--no-branch-switching", action="store_true",
                      help="stay on the branch the path starts on, even where it is unstable")
     sim.add_argument("--solver", choices=("static", "dynamic"), default="static",
@@ -81,9 +88,20 @@ def cmd_simulate(args) -> int:
         if not args.clamp_speed > 0:
             raise InputError(f"--clamp-speed = {args.clamp_speed} must be a positive speed in m/s")
         dynamic_options = DynamicOptions(clamp_speed=args.clamp_speed)
-    result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
-                      progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options,
-                      mesh=args.mesh, frames=args.frames, thresholds=not args.no_thresholds)
+    if args.model == "ribbon":
+        from .ribbon_runs import run_ribbon
+
+        if args.solver != "static" or args.mesh is not None or args.frames:
+            raise InputError("--model ribbon runs the static solver only, without --mesh or --frames")
+        result = run_ribbon(strip, protocol, args.ribbon_init or "direct", args.zeta, args.resolution, out=args.out,
+                            options=options, thresholds=not args.no_thresholds, progress=not args.quiet)
+    elif args.zeta is not None or args.ribbon_init is not None:
+        raise InputError(f"--zeta and --ribbon-init apply to --model ribbon only, not {args.model!r}")
+    else:
+        result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
+                          progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options,
+                          mesh=args.mesh, frames=args.frames, thresholds=not args.no_thresholds,
+                          branches=not args.no_branches)
     s = result.summary
     if not args.quiet:
         keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",

@@ -1,0 +1,196 @@
+"""Centerline curvatures along the arclength for the rod, the ribbon and the plate (Figs. A.12-A.14).
+
+For a framed centerline (nodes x_k, material directors m1 (the strip normal) and m2 = t x m1 per
+edge) the curvatures at interior nodes are those of the rod (Eqs. 3-5): the out-of-plane
+bending kappa^(2) = kb . (m2^{k-1} + m2^k)/2, the geodesic kappa^(1) = -kb . (m1^{k-1} + m1^k)/2,
+and the twist tau, the angle about t^k from the parallel transport of m1^{k-1} onto edge k to
+m1^k. They are integrated (dimensionless); divided by the Voronoi length they are curvatures,
+reported times L as in the paper's figures.
+
+- rod and ribbon: their own material frames and discrete twist (Eq. 5);
+- plate: the material line w = 0 sampled at `stations` points, m1 the surface normal at each
+  edge midpoint (s, 0) from the vertex normals, projected normal to t (section 4.3, App. F).
+"""
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+
+import numpy as np
+
+from .energies.hinge_bending import triangle_normals
+from .energies.rod_curvature import StencilGeometry, material_curvatures
+from .geometry.frames import cross, reference_twist, rowdot, unit
+from .geometry.strip import InputError
+from .io import atomic_write_text
+
+CURVATURE_COLUMNS = ("model", "step", "dL_over_L", "dW_over_L", "s_over_L", "k1_L", "k2_L", "tau_L")
+
+
+def framed_curve_curvatures(x: np.ndarray, m1: np.ndarray):
+    """Integrated (kappa^(1), kappa^(2), tau) at the interior nodes of a polyline x (n, 3) whose
+    edges carry unit normals m1 (n - 1, 3) perpendicular to them (Eqs. 3-5 with theta = 0)."""
+    t = unit(x[1:] - x[:-1])
+    m2 = cross(t, m1)
+    geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
+    kappa_n, kappa_g = material_curvatures(geom)
+    return kappa_g, kappa_n, reference_twist(m1, t)
+
+
+def rod_curvatures(model, q: np.ndarray) -> dict:
+    """Curvatures of the rod or ribbon at q (frames transported from the model's committed state):
+    s/L of the interior nodes and k1 L (geodesic), k2 L (bending), tau L (twist)."""
+    x = model.positions(q)
+    _, _, m1, m2, m_ref = model.frames(q)
+    geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
+    kappa_n, kappa_g = material_curvatures(geom)
+    theta = q[model.theta_dofs]
+    tau = theta[1:] - theta[:-1] + m_ref
+    L = model.strip.length
+    scale = L / model.voronoi_lengths
+    return {"s_over_L": model.centerline.node_arclength[1:-1] / L, "k1_L": kappa_g * scale, "k2_L": kappa_n * scale,
+            "tau_L": tau * scale}
+
+
+def plate_vertex_normals(model, q: np.ndarray) -> np.ndarray:
+    """Unit normals (N, 3) at the plate's nodes: area-weighted means of the deformed normals of
+    the triangles around each node, oriented as the rest normal +z."""
+    mesh = model.mesh
+    normals, double_area = triangle_normals(model.positions(q), mesh.triangles)
+    rest = mesh.nodes[mesh.triangles]
+    rest_z = ((rest[:, 1, 0] - rest[:, 0, 0]) * (rest[:, 2, 1] - rest[:, 0, 1])
+              - (rest[:, 1, 1] - rest[:, 0, 1]) * (rest[:, 2, 0] - rest[:, 0, 0]))
+    weighted = (np.sign(rest_z) * double_area)[:, None] * normals
+    summed = np.zeros((mesh.node_count, 3))
+    for corner in range(3):
+        np.add.at(summed, mesh.triangles[:, corner], weighted)
+    return unit(summed)
+
+
+def plate_centerline_frame(model, q: np.ndarray, stations: int):
+    """Points x (stations, 3) of the plate's line w = 0 at s = 0..L and, per edge between them,
+    m1: the surface normal at the edge midpoint (s, 0), interpolated linearly from the vertex
+    normals (a continuous normal field; the normal of the one triangle holding the point would
+    put all the twist on the hinges the line crosses), made normal to the edge."""
+    L = model.strip.length
+    x, s = model.centerline_positions(q, stations)
+    mid = 0.5 * (s[1:] + s[:-1])
+    nodes, weights = model.mesh.interpolation_matrix(np.stack([mid, np.zeros_like(mid)], axis=1))
+    normals = np.einsum("qk,qkc->qc", weights, plate_vertex_normals(model, q)[nodes])
+    t = unit(x[1:] - x[:-1])
+    m1 = unit(normals - rowdot(normals, t)[:, None] * t)
+    return x, m1, s / L
+
+
+def default_plate_stations(model) -> int:
+    """About one station per two columns of triangles: the line w = 0 interpolated through a
+    structured mesh kinks where it crosses alternate columns, which a station per column turns
+    into a zigzag of kappa^(2) (+-6 % at 846 triangles, measured); two columns smooth it."""
+    side = np.sqrt(4.0 * np.mean(model.mesh.triangle_areas) / np.sqrt(3.0))
+    return max(11, int(round(0.5 * model.strip.length / (0.5 * np.sqrt(3.0) * side))) + 1)
+
+
+def plate_curvatures(model, q: np.ndarray, stations: int | None = None) -> dict:
+    """Curvatures of the plate's centerline (w = 0) at q, as rod_curvatures."""
+    stations = default_plate_stations(model) if stations is None else stations
+    if not (isinstance(stations, (int, np.integer)) and stations >= 5):
+        raise InputError(f"stations = {stations!r} must be an integer >= 5")
+    x, m1, s = plate_centerline_frame(model, q, stations)
+    k1, k2, tau = framed_curve_curvatures(x, m1)
+    ds = (s[1] - s[0])
+    return {"s_over_L": s[1:-1], "k1_L": k1 / ds, "k2_L": k2 / ds, "tau_L": tau / ds}
+
+
+def centerline_curvatures(model, q: np.ndarray, stations: int | None = None) -> dict:
+    """k1 L, k2 L, tau L along s/L for any model (rod, ribbon, plate)."""
+    if hasattr(model, "mesh"):
+        return plate_curvatures(model, q, stations)
+    return rod_curvatures(model, q)
+
+
+def inflection_jumps(profile: dict, window: int = 6) -> list[dict]:
+    """At each sign change of k2 (an inflection point, away from the clamps): the jumps of k2 and
+    tau across it, relative to the typical step of each between neighbouring nodes nearby
+    (median over `window` steps either side). A smooth profile gives ratios ~1; a jump, >> 1."""
+    k2, tau, s = profile["k2_L"], profile["tau_L"], profile["s_over_L"]
+    out = []
+    sign_changes = np.flatnonzero(np.sign(k2[1:]) * np.sign(k2[:-1]) < 0)
+    for i in sign_changes:
+        if s[i] < 0.1 or s[i] > 0.9:
+            continue
+        lo, hi = max(0, i - window), min(len(k2) - 1, i + window + 1)
+        steps = np.r_[lo:i, i + 1:hi]
+        d_k2, d_tau = np.abs(np.diff(k2)), np.abs(np.diff(tau))
+        ratio = lambda d: float(d[i] / np.median(d[steps])) if np.median(d[steps]) > 0 else float("nan")  # noqa: E731
+        out.append({"s_over_L": float(0.5 * (s[i] + s[i + 1])),
+                    "k2_jump_ratio": ratio(d_k2), "tau_jump_ratio": ratio(d_tau),
+                    "tau_at_inflection_L": float(0.5 * (tau[i] + tau[i + 1])),
+                    "k2_jump_L": float(k2[i + 1] - k2[i]), "tau_jump_L": float(tau[i + 1] - tau[i])})
+    return out
+
+
+def write_curvatures_csv(path, records: list[dict]) -> None:
+    """curvatures.csv: one row per station of each record (a dict with model, step, dL_over_L,
+    dW_over_L and a profile from centerline_curvatures)."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(CURVATURE_COLUMNS)
+    for rec in records:
+        p = rec["profile"]
+        for k in range(len(p["s_over_L"])):
+            writer.writerow([rec["model"], rec["step"], repr(float(rec["dL_over_L"])), repr(float(rec["dW_over_L"])),
+                             *(repr(float(p[c][k])) for c in ("s_over_L", "k1_L", "k2_L", "tau_L"))])
+    atomic_write_text(Path(path), buf.getvalue())
+
+
+# ---------------------------------------------------------------------- states at requested shears
+def states_at_shears(model_name: str, strip, compression_ratio: float, shear_ratios, resolution=None, *,
+                     ribbon_init: str = "direct", zeta=None, max_step: float = 0.02, options=None, mesh=None):
+    """Run compression, then shear through the requested dW/L in increasing order (recorded steps
+    of at most max_step L, quasi-static), yielding (model, state) at each requested dW/L.
+
+    model_name: rod, plate, ribbon; for the ribbon ribbon_init="rod" follows the rod and relaxes
+    each requested state under the ribbon energy (ddg.ribbon_runs)."""
+    from .api import make_model
+    from .solve.continuation import ContinuationOptions, PathFollower
+
+    shear_ratios = sorted(float(r) for r in np.atleast_1d(shear_ratios))
+    if not shear_ratios or shear_ratios[0] < 0:
+        raise InputError(f"shear ratios = {shear_ratios!r} must be a non-empty list of dW/L >= 0")
+    limit = strip.shear_limit(compression_ratio * strip.length) / strip.length
+    if shear_ratios[-1] > limit:
+        raise InputError(f"dW/L = {shear_ratios[-1]:g} beyond the shear limit {limit:.6g} (Eq. B.1); allowed [0, {limit:.6g}]")
+    options = options or ContinuationOptions()
+    L = strip.length
+    relax = None
+    if model_name == "ribbon":
+        from .models.ribbon import RibbonModel
+        from .models.rod import RodModel
+        from .ribbon_runs import RIBBON_INITS, relax_from
+
+        if ribbon_init not in RIBBON_INITS:
+            raise InputError(f"ribbon init = {ribbon_init!r} is not available; choose one of {list(RIBBON_INITS)}")
+        ribbon = RibbonModel(strip, 101 if resolution is None else resolution, zeta=zeta)
+        driver = RodModel(strip, ribbon.nodes) if ribbon_init == "rod" else ribbon
+        if ribbon_init == "rod":
+            relax = lambda state: relax_from(ribbon, driver, state, options)  # noqa: E731
+    else:
+        driver = make_model(model_name, strip, resolution, mesh)
+        ribbon = None
+    follower = PathFollower(driver, options)
+    dL = compression_ratio * L
+    state = follower.rest()
+    steps = max(1, int(np.ceil(compression_ratio / max_step)))
+    for k in range(1, steps + 1):
+        state = follower.start_compression(dL * k / steps) if k == 1 else follower.advance(state, dL * k / steps, 0.0)
+    current = 0.0
+    for ratio in shear_ratios:
+        n = int(np.ceil((ratio - current) / max_step - 1e-9))
+        for k in range(1, n + 1):
+            state = follower.advance(state, dL, L * (current + (ratio - current) * k / n))
+        current = ratio
+        if relax is not None:
+            yield ribbon, relax(state)
+        else:
+            yield driver, state

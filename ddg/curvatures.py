@@ -68,19 +68,27 @@ def plate_vertex_normals(model, q: np.ndarray) -> np.ndarray:
     return unit(summed)
 
 
-def plate_centerline_frame(model, q: np.ndarray, stations: int):
-    """Points x (stations, 3) of the plate's line w = 0 at s = 0..L and, per edge between them,
-    m1: the surface normal at the edge midpoint (s, 0), interpolated linearly from the vertex
-    normals (a continuous normal field; the normal of the one triangle holding the point would
-    put all the twist on the hinges the line crosses), made normal to the edge."""
+def plate_centerline_frame(model, q: np.ndarray, stations):
+    """Points x (K, 3) of the plate's line w = 0 at K stations (a count, spread over s = 0..L, or
+    the rest arclengths s in metres) and, per edge between them, m1: the surface normal at the
+    edge midpoint (s, 0), interpolated linearly from the vertex normals (a continuous normal
+    field; the normal of the one triangle holding the point would put all the twist on the
+    hinges the line crosses), made normal to the edge. Returns x, m1, s / L."""
     L = model.strip.length
-    x, s = model.centerline_positions(q, stations)
+    s = np.linspace(0.0, L, stations) if np.ndim(stations) == 0 else np.asarray(stations, dtype=float)
+    x = _plate_points(model, q, s, np.zeros_like(s))
     mid = 0.5 * (s[1:] + s[:-1])
     nodes, weights = model.mesh.interpolation_matrix(np.stack([mid, np.zeros_like(mid)], axis=1))
     normals = np.einsum("qk,qkc->qc", weights, plate_vertex_normals(model, q)[nodes])
     t = unit(x[1:] - x[:-1])
     m1 = unit(normals - rowdot(normals, t)[:, None] * t)
     return x, m1, s / L
+
+
+def _plate_points(model, q, s, y):
+    """Deformed positions of the material points with rest coordinates (s, y)."""
+    nodes, weights = model.mesh.interpolation_matrix(np.stack([s, y], axis=1))
+    return np.einsum("qk,qkc->qc", weights, model.positions(q)[nodes])
 
 
 def default_plate_stations(model) -> int:
@@ -194,3 +202,34 @@ def states_at_shears(model_name: str, strip, compression_ratio: float, shear_rat
             yield ribbon, relax(state)
         else:
             yield driver, state
+
+
+# ---------------------------------------------------------------------- thickness study (Figs. A.13-A.14)
+def inflection_twist_study(width_ratios=(1 / 20, 1 / 6), slendernesses=(300.0, 600.0, 1200.0), shear_ratio: float = 0.3,
+                           compression_ratio: float = 0.5, triangles: int = 800, max_step: float = 0.05,
+                           options=None) -> list[dict]:
+    """The plate's centerline twist at its inflection points (k2 = 0, away from the clamps)
+    against L/b, at dW/L = shear_ratio on the stable path: per width and L/b, tau L at the
+    inflection (mean of |tau L| over the inflection points), the largest |tau L| along the
+    centerline, their ratio, and the k2 and tau jump ratios (inflection_jumps). As the plate
+    thins, stretching costs more against bending and the surface becomes developable, which
+    forces the twist at the inflection towards zero (Sadowsky's limit, Figs. A.13-A.14)."""
+    from .geometry.strip import Strip
+
+    rows = []
+    for ratio in width_ratios:
+        for slenderness in slendernesses:
+            strip = Strip.from_ratios(ratio, compression_ratio, slenderness)
+            ((model, state),) = list(states_at_shears("plate", strip, compression_ratio, [shear_ratio], triangles,
+                                                      max_step=max_step, options=options))
+            profile = plate_curvatures(model, state.q)
+            jumps = inflection_jumps(profile)
+            tau_infl = float(np.mean([abs(j["tau_at_inflection_L"]) for j in jumps])) if jumps else float("nan")
+            tau_max = float(np.max(np.abs(profile["tau_L"])))
+            rows.append({"W_over_L": ratio, "L_over_b": slenderness, "dW_over_L": shear_ratio,
+                         "inflections": len(jumps), "tau_inflection_L": tau_infl, "tau_max_L": tau_max,
+                         "tau_inflection_over_max": tau_infl / tau_max,
+                         "k2_jump_ratio": float(np.mean([j["k2_jump_ratio"] for j in jumps])) if jumps else float("nan"),
+                         "tau_jump_ratio": float(np.mean([j["tau_jump_ratio"] for j in jumps])) if jumps else float("nan"),
+                         "triangles": model.mesh.triangle_count})
+    return rows

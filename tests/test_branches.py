@@ -1,0 +1,130 @@
+"""The bifurcation diagram of the shear stage (ddg.solve.branches): every branch, stable and not,
+traced by pseudo-arclength continuation in dW (ddg.solve.arclength)."""
+import numpy as np
+import pytest
+from scipy.interpolate import CubicSpline, PchipInterpolator
+
+import ddg
+
+
+def run(model, resolution, shear_ratio, shear_steps):
+    strip = ddg.Strip.from_ratios(0.05, 0.5)
+    protocol = ddg.LoadingProtocol(0.5, shear_ratio=shear_ratio, compression_steps=20, shear_steps=shear_steps)
+    result = ddg.simulate(strip, protocol, model=model, resolution=resolution)
+    assert result.converged, result.summary["message"]
+    return result
+
+
+def branch(result, name, key=None):
+    rows = [r for r in result.branch_rows if r["branch"] == name]
+    return rows if key is None else np.array([r[key] for r in rows])
+
+
+@pytest.fixture(scope="module")
+def rod():
+    """W/L = 1/20, dL/L = 1/2, M = 100, sheared to dW/L = 0.6 (past dW2 = 0.524)."""
+    return run("rod", 100, 0.6, 60)
+
+
+@pytest.fixture(scope="module")
+def narrow_plate():
+    """The same scene as a plate of 600 triangles: its US branch ends in a fold (about 35 s)."""
+    return run("plate", 600, 0.47, 47)
+
+
+def test_the_diagram_has_U_both_US_branches_and_S(rod):
+    assert [b for b in rod.summary["branches"]] == ["U", "US+", "US-", "S+"]
+    assert {r["phase"] for r in branch(rod, "U")} == {"U"}
+    assert {r["phase"] for r in branch(rod, "US+")} == {"US+"}
+    assert {r["phase"] for r in branch(rod, "US-")} == {"US-"}
+    assert {r["phase"] for r in branch(rod, "S+")} == {"S+"}
+
+
+@pytest.mark.parametrize("which", ["rod", "narrow_plate"])
+def test_states_reported_stable_on_any_branch_have_positive_lambda_min(which, request):
+    """stable (a Cholesky factorisation succeeded) and lambda_min > 0 say the same thing, on the
+    recorded path and on every traced branch, unstable parts included."""
+    result = request.getfixturevalue(which)
+    for rows in (result.rows, result.branch_rows):
+        stable = np.array([bool(r["stable"]) for r in rows])
+        lam = np.array([r["lambda_min"] for r in rows])
+        assert np.all(lam[stable] > 0)
+        assert np.all(lam[~stable] < 0)
+    assert any(not r["stable"] for r in result.branch_rows)  # the unstable parts are there
+
+
+def test_U_branch_turns_unstable_at_dW1_and_matches_natural_continuation(rod):
+    """The arclength trace of U changes stability where the thresholds module puts dW1, and it
+    lies on the same equilibria as the recorded path (which follows U up to dW1)."""
+    dw, lam = branch(rod, "U", "dW_over_L"), branch(rod, "U", "lambda_min")
+    dw1 = rod.summary["dW1_over_L"]
+    k = int(np.nonzero(lam <= 0)[0][0])
+    assert dw[k - 1] < dw1 <= dw[k]
+    h_branch = CubicSpline(dw, branch(rod, "U", "H_mid_over_L"))  # interpolation error ~1e-7 L
+    path_dw = rod.column("dW_over_L", "shear")
+    on_u = path_dw < dw1
+    assert np.max(np.abs(h_branch(path_dw[on_u]) - rod.column("H_mid_over_L", "shear")[on_u])) < 1e-6
+
+
+def test_US_branches_run_from_the_pitchfork_to_the_S_branch(rod):
+    """US+ starts at U (dW1, the shape symmetric to 1e-4 L) and ends on S where S turns stable."""
+    s = rod.summary
+    for name in ("US+", "US-"):
+        dw, h = branch(rod, name, "dW_over_L"), branch(rod, name, "H_mid_over_L")
+        assert dw[0] == pytest.approx(s["dW1_over_L"], abs=1e-3)
+        assert dw[-1] == pytest.approx(s["dW2_S_stable_over_L"], abs=1e-3)
+        assert abs(h[-1]) < 5e-3
+        assert s["branches"][name]["end"] == "stop condition"
+
+
+def test_US_plus_and_US_minus_are_mirror_images(rod):
+    """Mirror images under the half turn about the vertical axis through the clamps' midpoint:
+    clamp force and energy equal along the branch; H_mid too, compared away from the two
+    junctions where H_mid(dW) has square-root ends (interpolation between different arclength
+    points; measured 2e-6 L)."""
+    s = rod.summary
+    plus, minus = branch(rod, "US+", "dW_over_L"), branch(rod, "US-", "dW_over_L")
+    inner = minus[(minus > s["dW1_over_L"] + 0.01) & (minus < s["dW2_S_stable_over_L"] - 0.01)]
+    assert inner.size > 10
+    for key, tolerance in (("H_mid_over_L", 1e-5), ("F_shear_norm", 1e-5), ("energy", 1e-6)):
+        a = PchipInterpolator(plus, branch(rod, "US+", key))(inner)
+        b = PchipInterpolator(minus, branch(rod, "US-", key))(inner)
+        scale = np.max(np.abs(branch(rod, "US+", key)))
+        assert np.max(np.abs(a - b)) < tolerance * max(scale, 1.0), key
+
+
+def test_S_branch_is_unstable_before_and_stable_after_dW2_S_stable(rod):
+    dw, lam = branch(rod, "S+", "dW_over_L"), branch(rod, "S+", "lambda_min")
+    order = np.argsort(dw)
+    dw, lam = dw[order], lam[order]
+    threshold = rod.summary["dW2_S_stable_over_L"]
+    assert np.all(lam[dw < threshold - 1e-3] < 0) and np.all(lam[(dw > threshold + 1e-3) & (dw < 0.6)] > 0)
+    assert np.all(np.abs(branch(rod, "S+", "H_mid_over_L")) < 1e-8)
+
+
+def test_narrow_plate_US_branch_folds_and_the_path_snaps_to_S(narrow_plate):
+    """The plate's US branch ends in a fold (a limit point in dW), not at the S pitchfork: past it
+    the branch turns back unstable and meets S at a smaller dW. The recorded path goes round the
+    fold by pseudo-arclength and snaps to S there; dW2 (the stable path reaches S, to 1e-3 L) is the
+    fold, and S turns stable just before it (measured 0.4517, 0.4519, 0.4511 at 600 triangles).
+    (A second, tiny fold pair at dW/L = 0.3745-0.3747 is a short unstable stretch inside US.)"""
+    s = narrow_plate.summary
+    assert len(s["folds_dW_over_L"]) == 1  # met by the recorded path
+    fold = s["folds_dW_over_L"][0]
+    assert fold == pytest.approx(s["dW2_over_L"], abs=1e-3)
+    assert s["dW2_S_stable_over_L"] < fold
+    dw, lam = branch(narrow_plate, "US+", "dW_over_L"), branch(narrow_plate, "US+", "lambda_min")
+    top = int(np.argmax(dw))
+    assert dw[top] == pytest.approx(fold, abs=2e-4)
+    beyond = slice(top + 1, None)
+    bottom = top + 1 + int(np.argmin(dw[beyond]))
+    assert bottom - top >= 3 and np.all(np.diff(dw[top:bottom + 1]) < 0)  # going back in dW ...
+    assert np.all(lam[top + 1:bottom] < 0)                                # ... unstable ...
+    # ... to S, which it meets where S turns stable. Near that junction the picture is a
+    # supercritical pitchfork of S (stable US for dW just below it), so the branch folds once
+    # more, 3e-5 L before S (measured 0.45104 vs 0.45107), and is stable from there to S.
+    assert dw[-1] == pytest.approx(s["dW2_S_stable_over_L"], abs=2e-4)
+    assert s["dW2_S_stable_over_L"] - dw[bottom] < 2e-4
+    assert abs(branch(narrow_plate, "US+", "H_mid_over_L")[-1]) < 0.03
+    phases = narrow_plate.column("phase", "shear")
+    assert phases[-1] == "S+" and "US+" in phases

@@ -1,0 +1,366 @@
+"""The loading protocol on the Naghdi strip: adaptive load stepping, stability, thresholds and
+branch switching (paper section 4, App. B, E).
+
+* Compression: from an inextensible guess (shell.NaghdiStrip.inextensible_guess) at the first
+  load step (at most dL/L = 0.2: the cosine mode cannot span more inextensibly), then the clamp
+  at x = L moves by -dL in `compression_steps` recorded steps.
+* Shear: the same clamp moves by dW along y in `shear_steps` recorded steps up to dW_max
+  (Eq. B.1) or the requested shear ratio.
+* Each recorded step is reached by adaptive substeps: secant predictor from the last two
+  converged states on the branch, Newton (solver.Solver) with the clamp increment lifted into
+  the first correction (a tangent predictor); a failed substep is retried without the secant
+  predictor, then halved; a substep that converged in <= 4 iterations doubles the next one.
+* Stability after every recorded step: inertia of the constrained tangent (MUMPS L D L^T) and
+  its lowest eigenvalue in the metric of shell.EIGEN_NORMALISATION (SLEPc shift-invert).
+* dW1: the symmetric mesh keeps the U branch exactly symmetric, so the path stays on U past the
+  pitchfork; at the first recorded step with a negative eigenvalue the bracket is bisected on
+  the U branch (solving from the last stable U state) until it is narrower than 1e-4 L.
+* Branch switch: at that step, the critical mode phi (displacement part normalised to max 1 in
+  units of L, sign chosen so the highest point moves into the first half: US+) is added with
+  the amplitude that minimises the energy along phi, searched from `perturbation` upward
+  (or downward) by factors of 2, then Newton. The switch counts only if the result is US
+  (no half-turn symmetry to 1e-4 L) and has no negative eigenvalue.
+* dW2: once on US, the first recorded step labelled S is bracketed and bisected (solving from
+  the last US state) to 1e-3 L: dW2 is the smallest dW found in S.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .shell import NaghdiStrip
+from .solver import NewtonFailure, Solver
+
+#: Largest deviation from a symmetry (units of L) for a shape to count as having it (the DDG
+#: models use the same, ddg.observables.SYMMETRY_TOLERANCE).
+SYMMETRY_TOLERANCE = 1e-4
+DW1_TOLERANCE = 1e-4
+DW2_TOLERANCE = 1e-3
+#: The inextensible cosine guess is used at most at this compression (units of L).
+GUESS_COMPRESSION_LIMIT = 0.2
+
+
+class ContinuationFailure(RuntimeError):
+    pass
+
+
+@dataclass
+class StepStats:
+    newton_iterations: int = 0
+    substeps: int = 0
+    rejected: int = 0
+
+
+@dataclass
+class ContinuationOptions:
+    min_substep: float = 1e-7  # units of L
+    max_substep: float = 0.05  # units of L
+    easy_iterations: int = 4
+    max_growth: float = 2.0
+    perturbation: float = 1e-3  # starting amplitude of the branch-switch perturbation, units of L
+    branch_switching: bool = True
+    thresholds: bool = True
+    eigenvalues: bool = True
+
+
+@dataclass
+class Branch:
+    """Last converged states on the current branch (for the secant predictor)."""
+
+    loads: list = field(default_factory=list)
+    states: list = field(default_factory=list)
+
+    def push(self, load, state):
+        self.loads = (self.loads + [np.asarray(load, float)])[-2:]
+        self.states = (self.states + [state])[-2:]
+
+    def reset(self, load, state):
+        self.loads, self.states = [np.asarray(load, float)], [state]
+
+
+class Stepper:
+    """Adaptive load stepping of one NaghdiStrip; loads are (compression, shear) in units of L."""
+
+    def __init__(self, model: NaghdiStrip, solver: Solver, options: ContinuationOptions):
+        self.model, self.solver, self.options = model, solver, options
+        self.branch = Branch()
+        self.substep = math.inf
+
+    @property
+    def load(self) -> np.ndarray:
+        return np.array(self.model.clamp)
+
+    def _predict(self, target: np.ndarray) -> np.ndarray | None:
+        b = self.branch
+        if len(b.states) < 2:
+            return None
+        d_old = b.loads[1] - b.loads[0]
+        d_new = target - b.loads[1]
+        n_old, n_new = np.linalg.norm(d_old), np.linalg.norm(d_new)
+        if n_old == 0.0 or n_new == 0.0 or np.dot(d_old, d_new) < 0.999 * n_old * n_new:
+            return None
+        return b.states[1] + (b.states[1] - b.states[0]) * (n_new / n_old)
+
+    def solve_at(self, target, state0: np.ndarray, use_predictor: bool = True) -> int:
+        """Newton at load `target` from state0 (or the secant prediction); raises NewtonFailure."""
+        target = np.asarray(target, float)
+        guess = self._predict(target) if use_predictor else None
+        self.model.set_state(state0 if guess is None else guess)
+        self.model.set_clamp(*target)
+        return self.solver.newton()
+
+    def advance(self, target) -> StepStats:
+        """From the current converged state to the load `target` by adaptive substeps."""
+        target = np.asarray(target, float)
+        stats = StepStats()
+        start_state = self.model.get_state()
+        current = self.load
+        if len(self.branch.states) == 0:
+            self.branch.reset(current, start_state)
+        while np.linalg.norm(target - current) > 1e-14:
+            remaining = np.linalg.norm(target - current)
+            size = min(self.substep, remaining, self.options.max_substep)
+            trial = target if size >= remaining * (1 - 1e-12) else current + (target - current) * (size / remaining)
+            state0 = self.branch.states[-1]
+            ok = False
+            for use_predictor in (True, False):
+                try:
+                    its = self.solve_at(trial, state0, use_predictor)
+                    ok = True
+                    break
+                except NewtonFailure:
+                    stats.rejected += 1
+                    if self._predict(trial) is None:
+                        break
+            if not ok:
+                self.model.set_state(state0)
+                self.model.set_clamp(*current)
+                self.substep = size / 2.0
+                if self.substep < self.options.min_substep:
+                    raise ContinuationFailure(
+                        f"load step below {self.options.min_substep:g} L without convergence from "
+                        f"dL/L = {current[0]:.6f}, dW/L = {current[1]:.6f}")
+                continue
+            stats.newton_iterations += its
+            stats.substeps += 1
+            current = trial
+            self.branch.push(current, self.model.get_state())
+            if its <= self.options.easy_iterations:
+                self.substep = size * self.options.max_growth
+            else:
+                self.substep = size
+        return stats
+
+    def restore(self, load, state, history: Branch | None = None) -> None:
+        self.model.set_state(state)
+        self.model.set_clamp(*load)
+        if history is not None:
+            self.branch = Branch(list(history.loads), list(history.states))
+        else:
+            self.branch.reset(load, state)
+
+
+# --- observation ------------------------------------------------------------------------------
+def phase_of(model: NaghdiStrip, positions: np.ndarray) -> tuple[str, float, float]:
+    """U, US+, US-, S+, S- (or '' for the flat strip) by the rule of ddg.observables.phase_label:
+    U if invariant under the half turn about the vertical axis through c, S if invariant under
+    the point reflection through c, US otherwise (to SYMMETRY_TOLERANCE L); + when the highest
+    point of the centerline (material line y = 0) lies in its first half (x < L/2)."""
+    mirror, point = model.symmetry_defects(positions)
+    compression, _ = model.clamp
+    z = positions[model.centerline_nodes, 2]
+    xs = model.nodes_ref[model.centerline_nodes, 0]
+    if compression == 0.0 and abs(positions[model.centre_node, 2]) < SYMMETRY_TOLERANCE:
+        return "", mirror, point
+    if mirror < SYMMETRY_TOLERANCE:
+        return "U", mirror, point
+    rise = float(np.max(z[xs < 0.5 - 1e-12]) - np.max(z[xs > 0.5 + 1e-12]))
+    sign = "+" if rise >= 0.0 else "-"
+    return ("S" if point < SYMMETRY_TOLERANCE else "US") + sign, mirror, point
+
+
+@dataclass
+class Observation:
+    row: dict
+    state: np.ndarray
+    negative: int
+    mode: np.ndarray | None = None
+
+
+class Observer:
+    """Rows of path.csv from the current state of the model."""
+
+    def __init__(self, model: NaghdiStrip, solver: Solver, energy_unit: float, eigenvalues: bool = True):
+        self.model, self.solver = model, solver
+        self.energy_unit = energy_unit
+        self.eigenvalues = eigenvalues
+
+    def observe(self, stage: str, iterations: int, switched: bool = False, wall: float = float("nan"),
+                want_mode: bool = False) -> Observation:
+        m = self.model
+        pos = m.positions()
+        phase, mirror, point = phase_of(m, pos)
+        force = m.clamp_reaction() / 12.0  # units of E b^3 / L (D = 1, see shell docstring)
+        negative = self.solver.negative_eigenvalues()
+        lam, mode = float("nan"), None
+        if self.eigenvalues or want_mode:
+            values, vectors = self.solver.lowest_modes(1)
+            if len(values):
+                lam, mode = float(values[0]), vectors[0]
+        compression, shear = m.clamp
+        row = {
+            "stage": stage,
+            "dL_over_L": compression,
+            "dW_over_L": shear,
+            "H_mid_over_L": float(pos[m.centre_node, 2]),
+            "F_shear_norm": float(force[1]),
+            "energy": m.energy() * self.energy_unit,
+            "lambda_min": lam,
+            "phase": phase,
+            "F_axial_norm": -float(force[0]),
+            "stable": negative == 0,
+            "newton_iterations": int(iterations),
+            "branch_switched": bool(switched),
+            **m.resolution_indicators(),
+            "negative_eigenvalues": int(negative),
+            "half_turn_defect_over_L": mirror,
+            "point_reflection_defect_over_L": point,
+            "wall_time_s": wall,
+        }
+        return Observation(row, m.get_state(), negative, mode)
+
+    def centerline(self, stations: int = 101) -> np.ndarray:
+        """(stations, 3) deformed material line y = 0, units of L, uniform in x."""
+        m = self.model
+        pos = m.positions()[m.centerline_nodes]
+        s = np.linspace(0.0, 1.0, stations)
+        xs = m.nodes_ref[m.centerline_nodes, 0]
+        return np.column_stack([np.interp(s, xs, pos[:, k]) for k in range(3)])
+
+
+# --- thresholds and branch switching -------------------------------------------------------------
+def locate_dw1(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW1_TOLERANCE):
+    """Bisect on the U branch for the first negative eigenvalue of the tangent.
+
+    low = (load, state, history) of the last stable U state; high_shear the first unstable dW.
+    Returns (dW1, newton_iterations) with dW1 the midpoint of the final bracket (< tol wide)."""
+    load_a, state_a, history_a = low
+    a, b = float(load_a[1]), float(high_shear)
+    iterations = 0
+    while b - a > tol:
+        mid = 0.5 * (a + b)
+        stepper.restore(load_a, state_a, history_a)
+        stats = stepper.advance((load_a[0], mid))
+        iterations += stats.newton_iterations
+        if stepper.solver.negative_eigenvalues() == 0:
+            a = mid
+            load_a, state_a = np.array(stepper.load), stepper.model.get_state()
+            history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
+        else:
+            b = mid
+    return 0.5 * (a + b), iterations
+
+
+def switch_branch(stepper: Stepper, mode: np.ndarray, perturbation: float, growth: float = 2.0,
+                  max_amplitude: float = 0.5, max_increment: float = 0.01):
+    """Leave the unstable U state (current) for US+ along the critical mode phi.
+
+    The state is held at RMS amplitude A (units of L) along phi by a force mu M phi (bordered
+    Newton, solver.newton_bordered), A growing from `perturbation` in increments that double
+    (up to max_increment, halved on failure, secant predictor) until the holding force changes sign (A passed the US amplitude); Newton without the constraint from
+    the interpolated state then lands on US+ (a pure perturbation of the U state followed by
+    Newton falls back to U: the linear mode stretches the mid-surface at finite amplitude).
+    Returns (iterations, amplitude) or raises ContinuationFailure unless the result is US with
+    no negative eigenvalue."""
+    from petsc4py import PETSc
+
+    m, solver = stepper.model, stepper.solver
+    base = m.get_state()
+    load = stepper.load
+    c = solver.M.createVecLeft()
+    phi_vec = c.duplicate()
+    phi_vec.setArray(mode)
+    solver.M.mult(phi_vec, c)
+    area = m.params.width
+    phi = mode * math.sqrt(area / phi_vec.dot(c))  # RMS displacement of phi = 1 (units of L)
+    m.set_state(phi)
+    phi_u = m.displacement_nodes()
+    xs = m.nodes_ref[m.centerline_nodes, 0]
+    z = phi_u[m.centerline_nodes, 2]
+    if np.max(z[xs < 0.5]) - np.max(z[xs > 0.5]) < 0.0:
+        phi = -phi
+    phi_vec.setArray(phi / area)  # c . (q - q_U) = RMS amplitude along phi
+    solver.M.mult(phi_vec, c)
+    iterations = 0
+    history = [(0.0, 0.0, base)]  # (amplitude, holding force mu, state)
+    da = perturbation
+    while True:
+        a_last, mu_last, s_last = history[-1]
+        a = a_last + da
+        if a > max_amplitude:
+            m.set_state(base)
+            raise ContinuationFailure(f"branch switch at dW/L = {load[1]:.5f}: the force holding the mode "
+                                      f"amplitude kept its sign up to {max_amplitude} L")
+        if len(history) >= 2:  # secant predictor in the amplitude
+            a_prev, _, s_prev = history[-2]
+            guess = s_last + (s_last - s_prev) * (da / (a_last - a_prev))
+        else:
+            guess = base + a * phi
+        m.set_state(guess)
+        m.set_clamp(*load)
+        try:
+            its, mu = solver.newton_bordered(c, base, a, mu_last)
+        except NewtonFailure:
+            da /= 2.0
+            if da < 1e-3 * perturbation:
+                m.set_state(base)
+                raise ContinuationFailure(f"branch switch at dW/L = {load[1]:.5f}: amplitude continuation "
+                                          f"stalled at {a_last:.3g} L") from None
+            continue
+        iterations += its
+        history.append((a, mu, m.get_state()))
+        if mu <= 0.0:
+            break
+        if its <= 4:
+            da = min(growth * da, max_increment)
+    (a0, mu0, s0), (a1, mu1, s1) = history[-2], history[-1]
+    w = mu0 / (mu0 - mu1)
+    m.set_state(s0 + w * (s1 - s0))
+    m.set_clamp(*load)
+    try:
+        iterations += solver.newton()
+    except NewtonFailure as exc:
+        m.set_state(base)
+        raise ContinuationFailure(f"branch switch at dW/L = {load[1]:.5f}: {exc}") from None
+    phase, _, _ = phase_of(m, m.positions())
+    if not (phase.startswith("US") and solver.negative_eigenvalues() == 0):
+        m.set_state(base)
+        raise ContinuationFailure(f"branch switch at dW/L = {load[1]:.5f} reached {phase or 'flat'}, not a stable US")
+    stepper.branch.reset(load, m.get_state())
+    c.destroy()
+    phi_vec.destroy()
+    return iterations, a0 + w * (a1 - a0)
+
+
+def locate_dw2(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW2_TOLERANCE):
+    """Smallest dW (to tol) at which the stable path, followed from the last US state `low`,
+    is point-symmetric (phase S). Returns (dW2, newton_iterations)."""
+    load_a, state_a, history_a = low
+    a, b = float(load_a[1]), float(high_shear)
+    iterations = 0
+    while b - a > tol:
+        mid = 0.5 * (a + b)
+        stepper.restore(load_a, state_a, history_a)
+        stats = stepper.advance((load_a[0], mid))
+        iterations += stats.newton_iterations
+        phase, _, _ = phase_of(stepper.model, stepper.model.positions())
+        if phase.startswith("S"):
+            b = mid
+        else:
+            a = mid
+            load_a, state_a = np.array(stepper.load), stepper.model.get_state()
+            history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
+    return b, iterations

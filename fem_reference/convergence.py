@@ -1,0 +1,160 @@
+"""Mesh convergence of the FEM reference: `python -m fem_reference convergence ...`.
+
+Runs the full protocol on 3-4 meshes (elements along L; across W near-isotropic), then
+
+* H_mid/L(dW) of each mesh on a common dW grid (the recorded shear steps; the path switched to
+  US+ where it exists), Richardson-extrapolated from the three finest meshes with the observed
+  order p = log(|f2 - f1| / |f3 - f2|) / log(r) (r the refinement ratio; P2 elements give p ~ 2,
+  clipped to [0.5, 4]), and each mesh's estimated error |f_h - f_extrapolated|;
+* dW1/L of each mesh and its Richardson extrapolation;
+* wall time per recorded load step and per path of each mesh.
+
+Writes OUT/convergence.csv (one row per mesh and dW), OUT/thresholds.csv (one row per mesh) and
+OUT/convergence.md (the table), plus each run's path.csv and summary.json under OUT/N<res>/.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ddg.io import atomic_write_text
+
+
+def observed_order(f1, f2, f3, ratio):
+    """Order p from three solutions on meshes h, h/r, h/r^2 (f3 finest); nan if not monotone."""
+    d1, d2 = f2 - f1, f3 - f2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        p = np.log(np.abs(d1 / d2)) / math.log(ratio)
+    return np.where(d1 * d2 > 0, p, np.nan)
+
+
+def richardson(f2, f3, ratio, p):
+    """Extrapolated value from the two finest meshes with order p."""
+    return f3 + (f3 - f2) / (ratio**p - 1.0)
+
+
+def extrapolate(values: np.ndarray, resolutions, default_order=2.0):
+    """values[mesh, point] on meshes `resolutions` (increasing): (extrapolated, order) per point,
+    the order observed on the three finest meshes where monotone (clipped to [0.5, 4]), else
+    default_order (P2)."""
+    res = np.asarray(resolutions, float)
+    r = res[-1] / res[-2]
+    if len(res) >= 3:
+        p = observed_order(values[-3], values[-2], values[-1], res[-2] / res[-3])
+        p = np.where(np.isfinite(p), np.clip(p, 0.5, 4.0), default_order)
+    else:
+        p = np.full(values.shape[1:], default_order)
+    return richardson(values[-2], values[-1], r, p), p
+
+
+def run_convergence(args) -> int:
+    from .api import simulate
+    from .cli import _scene
+
+    strip, protocol = _scene(args)
+    out = Path(args.out)
+    resolutions = sorted(args.resolutions)
+    runs = []
+    for n in resolutions:
+        result = simulate(strip, protocol, n, out=out / f"N{n}", fields=False, progress=not args.quiet)
+        runs.append(result)
+        if not args.quiet:
+            print(f"N = {n}: dW1/L = {result.summary['dW1_over_L']}, dW2/L = {result.summary['dW2_over_L']}, "
+                  f"{result.summary['wall_time_s']:.1f} s, converged {result.converged}", flush=True)
+    rows, table = summarise(runs, resolutions)
+    write_outputs(out, rows, table, runs, resolutions, strip, protocol)
+    return 0 if all(r.converged for r in runs) else 3
+
+
+def summarise(runs, resolutions):
+    """Per-mesh H_mid(dW) on the common recorded grid, extrapolated values and estimated errors."""
+    shear = [[r for r in run.rows if r["stage"] == "shear"] for run in runs]
+    n_common = min(len(s) for s in shear)
+    dw = np.array([row["dW_over_L"] for row in shear[0][:n_common]])
+    H = np.array([[row["H_mid_over_L"] for row in s[:n_common]] for s in shear])
+    compressed = np.array([[run.summary["H_mid_over_L_compressed"]] for run in runs])
+    H_ext, p = extrapolate(H, resolutions) if len(runs) >= 2 else (H[-1], np.full(n_common, np.nan))
+    Hc_ext, pc = extrapolate(compressed, resolutions) if len(runs) >= 2 else (compressed[-1], [np.nan])
+    rows = []
+    for i, run in enumerate(runs):
+        for j in range(n_common):
+            rows.append({"resolution": resolutions[i], "dW_over_L": dw[j], "H_mid_over_L": H[i, j],
+                         "phase": shear[i][j]["phase"], "H_extrapolated": H_ext[j], "order": p[j],
+                         "error_estimate": abs(H[i, j] - H_ext[j])})
+    dw1 = np.array([np.nan if run.summary["dW1_over_L"] is None else run.summary["dW1_over_L"] for run in runs])
+    dw2 = np.array([np.nan if run.summary["dW2_over_L"] is None else run.summary["dW2_over_L"] for run in runs])
+    dw1_ext, p1 = extrapolate(dw1[:, None], resolutions) if len(runs) >= 2 else (dw1[-1:], [np.nan])
+    table = []
+    for i, run in enumerate(runs):
+        s = run.summary
+        steps = s["recorded_steps"] - 1
+        table.append({
+            "resolution": resolutions[i],
+            "triangles": s["mesh"]["triangles"],
+            "n_dof": s["n_dof"],
+            "H_compressed": s["H_mid_over_L_compressed"],
+            "H_compressed_error": abs(s["H_mid_over_L_compressed"] - float(Hc_ext[0])),
+            "dW1_over_L": dw1[i],
+            "dW1_error": abs(dw1[i] - float(dw1_ext[0])),
+            "dW2_over_L": dw2[i],
+            "H_max_error": float(np.nanmax(np.abs(H[i] - H_ext))),
+            "H_max_error_away": float(np.nanmax(np.where(_away(dw, dw1_ext[0], dw2[-1]), np.abs(H[i] - H_ext), np.nan))),
+            "wall_time_path_s": s["wall_time_s"],
+            "wall_time_per_step_s": s["wall_time_s"] / max(steps, 1),
+            "newton_iterations": s["newton_iterations"],
+            "converged": s["converged"],
+        })
+    table.append({"resolution": "extrapolated", "H_compressed": float(Hc_ext[0]), "dW1_over_L": float(dw1_ext[0]),
+                  "order_H_compressed": float(np.asarray(pc).ravel()[0]), "order_dW1": float(np.asarray(p1).ravel()[0])})
+    return rows, table
+
+
+def _away(dw, dw1, dw2, margin=0.02):
+    """dW values at least `margin` from both thresholds (where H_mid is smooth in the mesh)."""
+    mask = np.ones_like(dw, dtype=bool)
+    for t in (dw1, dw2):
+        if t is not None and np.isfinite(t):
+            mask &= np.abs(np.abs(dw) - t) > margin
+    return mask
+
+
+def write_outputs(out: Path, rows, table, runs, resolutions, strip, protocol) -> None:
+    out.mkdir(parents=True, exist_ok=True)
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
+    w.writeheader()
+    w.writerows(rows)
+    atomic_write_text(out / "convergence.csv", buf.getvalue())
+    keys = sorted({k for t in table for k in t}, key=lambda k: list(table[0]).index(k) if k in table[0] else 99)
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=keys, lineterminator="\n")
+    w.writeheader()
+    w.writerows(table)
+    atomic_write_text(out / "thresholds.csv", buf.getvalue())
+
+    def f(v, fmt="{:.5f}"):
+        return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else fmt.format(v)
+
+    lines = [f"# FEM mesh convergence: W/L = {strip.width_ratio:.4g}, dL/L = {protocol.compression_ratio:g}, "
+             f"L/b = {strip.slenderness:.0f}", "",
+             "Richardson extrapolation from the finest meshes with the observed order (clipped to [0.5, 4]); "
+             "errors are |value - extrapolated|. H errors over the common recorded dW grid; 'away' excludes "
+             "dW within 0.02 L of dW1 and dW2.", "",
+             "| N along L | triangles | unknowns | H_mid/L compressed | error | dW1/L | error | dW2/L | "
+             "max H error | max H error away | s / step | s / path | Newton its |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for t in table[:-1]:
+        lines.append(f"| {t['resolution']} | {t['triangles']} | {t['n_dof']} | {f(t['H_compressed'], '{:.6f}')} | "
+                     f"{f(t['H_compressed_error'], '{:.1e}')} | {f(t['dW1_over_L'], '{:.4f}')} | "
+                     f"{f(t['dW1_error'], '{:.1e}')} | {f(t['dW2_over_L'], '{:.3f}')} | {f(t['H_max_error'], '{:.1e}')} | "
+                     f"{f(t['H_max_error_away'], '{:.1e}')} | {f(t['wall_time_per_step_s'], '{:.2f}')} | "
+                     f"{f(t['wall_time_path_s'], '{:.0f}')} | {t['newton_iterations']} |")
+    e = table[-1]
+    lines += ["", f"Extrapolated: H_mid/L compressed = {f(e['H_compressed'], '{:.6f}')} (order "
+              f"{f(e['order_H_compressed'], '{:.2f}')}), dW1/L = {f(e['dW1_over_L'], '{:.4f}')} "
+              f"(order {f(e['order_dW1'], '{:.2f}')}).", ""]
+    atomic_write_text(out / "convergence.md", "\n".join(lines) + "\n")

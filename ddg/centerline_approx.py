@@ -141,15 +141,17 @@ def centerline_error_study(width_ratios=PAPER_WIDTH_RATIOS, shear_ratios=PAPER_S
     return rows
 
 
-def check_ratios(name: str, values, low: float, high: float) -> list[float]:
-    """Parse a list of ratios within (low, high]; InputError naming the bad value otherwise."""
+def check_ratios(name: str, values, low: float, high: float, low_inclusive: bool = False) -> list[float]:
+    """Parse a list of ratios within (low, high] ([low, high] with low_inclusive); InputError naming
+    the bad value otherwise."""
     out = []
+    bracket = "[" if low_inclusive else "("
     for v in values:
         try:
             f = float(v)
         except (TypeError, ValueError):
-            raise InputError(f"{name} = {v!r} is not a number; allowed ({low:g}, {high:g}]") from None
-        if not (low < f <= high):
-            raise InputError(f"{name} = {f:g} outside the allowed range ({low:g}, {high:g}]")
+            raise InputError(f"{name} = {v!r} is not a number; allowed {bracket}{low:g}, {high:g}]") from None
+        if not ((low <= f if low_inclusive else low < f) and f <= high):
+            raise InputError(f"{name} = {f:g} outside the allowed range {bracket}{low:g}, {high:g}]")
         out.append(f)
     return out

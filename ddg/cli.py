@@ -1,4 +1,5 @@
-"""Command line: `python -m ddg simulate ...`, a thin layer over ddg.simulate.
+"""Command line: `python -m ddg simulate ...`, a thin layer over ddg.simulate; `python -m ddg
+curvatures ...` and `python -m ddg centerline-error ...` (ddg.curvatures, ddg.centerline_approx).
 
 Exit codes: 0 path complete; 2 bad arguments (one-line message); 3 the run stopped
 converging (the converged part of the path is written, the message says where).
@@ -64,7 +65,124 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--max-newton-iterations", type=int, default=15, help="per load step (default 15)")
     sim.add_argument("--out", default="out", help="output directory (default ./out)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar or result print-out")
+
+    cur = sub.add_parser("curvatures", help="centerline curvatures k1, k2, tau along s (Figs. A.12-A.14): CSV and PNG")
+    cur.add_argument("--model", default="rod", choices=("rod", "plate", "ribbon"), help="rod (default), plate or ribbon")
+    cur.add_argument("--width-ratio", type=float, default=0.05, help="W/L (default 0.05)")
+    cur.add_argument("--compression-ratio", type=float, default=0.5, help="dL/L (default 0.5)")
+    cur.add_argument("--shear-ratios", default="0,0.3,0.45", help="comma-separated dW/L to report (default 0,0.3,0.45)")
+    cur.add_argument("--slenderness", type=float, default=None, help="L/b (default: b = 0.127 mm)")
+    cur.add_argument("--resolution", type=int, default=None,
+                     help="rod/ribbon: node count (default 100 / 101); plate: target triangles (default 2000)")
+    cur.add_argument("--zeta", type=float, default=None, help="ribbon: zeta of Eq. (A.5) in metres (default 1e4 L)")
+    cur.add_argument("--ribbon-init", choices=("direct", "rod"), default="direct", help="ribbon: direct (default) or rod")
+    cur.add_argument("--stations", type=int, default=None, help="plate: centerline stations (default ~ columns / 2)")
+    cur.add_argument("--out", default="out", help="output directory: curvatures.csv, curvatures.png (default ./out)")
+
+    err = sub.add_parser("centerline-error",
+                         help="plate centerline approximation error (Eqs. 12-13) against L/W (Fig. 10): CSV and PNG")
+    err.add_argument("--width-ratios", default="0.5,0.3333333333333333,0.16666666666666666,0.08333333333333333,0.05",
+                     help="comma-separated W/L (default 1/2, 1/3, 1/6, 1/12, 1/20)")
+    err.add_argument("--shear-ratios", default="0.1,0.3,0.5", help="comma-separated dW/L (default 0.1,0.3,0.5)")
+    err.add_argument("--compression-ratio", type=float, default=0.5, help="dL/L (default 0.5)")
+    err.add_argument("--slenderness", type=float, default=None, help="L/b (default: b = 0.127 mm)")
+    err.add_argument("--resolution", type=int, default=800, help="target triangle count (default 800)")
+    err.add_argument("--out", default="out", help="output directory: centerline_error.csv, .png (default ./out)")
     return parser
+
+
+def _ratios(name: str, text: str, low: float, high: float, low_inclusive: bool = False) -> list[float]:
+    from .centerline_approx import check_ratios
+
+    return check_ratios(name, [v for v in str(text).split(",") if v.strip()] or [text], low, high, low_inclusive)
+
+
+def cmd_curvatures(args) -> int:
+    """Curvature profiles at the requested shears: OUT/curvatures.csv and OUT/curvatures.png."""
+    from .curvatures import centerline_curvatures, inflection_jumps, states_at_shears, write_curvatures_csv
+
+    strip = Strip.from_ratios(args.width_ratio, args.compression_ratio, args.slenderness)
+    shears = _ratios("--shear-ratios dW/L", args.shear_ratios, 0.0, 1.0, low_inclusive=True)
+    if args.model != "ribbon" and args.zeta is not None:
+        raise InputError(f"--zeta applies to --model ribbon only, not {args.model!r}")
+    if args.stations is not None and args.model != "plate":
+        raise InputError(f"--stations applies to --model plate only, not {args.model!r}")
+    records = []
+    states = states_at_shears(args.model, strip, args.compression_ratio, shears, args.resolution,
+                              ribbon_init=args.ribbon_init, zeta=args.zeta)
+    for step, (model, state) in enumerate(states):
+        profile = centerline_curvatures(model, state.q, args.stations) if args.model == "plate" \
+            else centerline_curvatures(model, state.q)
+        records.append({"model": args.model, "step": step, "dL_over_L": state.compression / strip.length,
+                        "dW_over_L": state.shear / strip.length, "profile": profile,
+                        "inflections": inflection_jumps(profile)})
+    out = Path(args.out)
+    write_curvatures_csv(out / "curvatures.csv", records)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(records), 1, figsize=(6.4, 2.4 * len(records)), sharex=True, squeeze=False)
+    for ax, rec in zip(axes[:, 0], records):
+        p = rec["profile"]
+        ax.plot(p["s_over_L"], p["k2_L"], "s", ms=3, color="green", label=r"$\kappa^{(2)}L$")
+        ax.plot(p["s_over_L"], p["tau_L"], "o", ms=3, color="red", label=r"$\tau L$")
+        ax.plot(p["s_over_L"], p["k1_L"], "^", ms=3, color="black", label=r"$\kappa^{(1)}L$")
+        ax.axhline(0.0, color="0.7", lw=0.5)
+        ax.set_title(f"{args.model}, W/L = {strip.width_ratio:.4g}, dW/L = {rec['dW_over_L']:.3g}", fontsize=9)
+    axes[0, 0].legend(fontsize=8)
+    axes[-1, 0].set_xlabel("s / L")
+    fig.tight_layout()
+    fig.savefig(out / "curvatures.png", dpi=120)
+    plt.close(fig)
+    for rec in records:
+        jumps = ", ".join(f"s/L={j['s_over_L']:.3f}: k2 jump x{j['k2_jump_ratio']:.3g}, tau L={j['tau_at_inflection_L']:.3g}"
+                          for j in rec["inflections"])
+        print(f"dW/L = {rec['dW_over_L']:.4g}: inflections {jumps or 'none'}")
+    print(f"wrote {out / 'curvatures.csv'} and {out / 'curvatures.png'}")
+    return 0
+
+
+def cmd_centerline_error(args) -> int:
+    """Fig. 10: OUT/centerline_error.csv (mean and max of Eq. 13 per W/L and dW/L) and a PNG."""
+    import csv
+    import io as _io
+
+    from .centerline_approx import centerline_error_study
+    from .io import atomic_write_text
+
+    widths = _ratios("--width-ratios W/L", args.width_ratios, 0.0, 1.0)
+    shears = _ratios("--shear-ratios dW/L", args.shear_ratios, 0.0, 1.0)
+    rows = centerline_error_study(widths, shears, args.compression_ratio, args.resolution, args.slenderness)
+    out = Path(args.out)
+    columns = ("L_over_W", "W_over_L", "dW_over_L", "mean_error", "max_error", "rod_edge_mean_error",
+               "ribbon_edge_mean_error", "phase", "triangles", "message")
+    buf = _io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=columns, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write_text(out / "centerline_error.csv", buf.getvalue())
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.0, 3.6))
+    for shear in shears:
+        mine = sorted((r for r in rows if abs(r["dW_over_L"] - shear) < 1e-9), key=lambda r: r["L_over_W"])
+        ax.plot([r["L_over_W"] for r in mine], [100 * r["mean_error"] for r in mine], "o-", label=f"dW/L = {shear:g}")
+    ax.set_xlabel("L / W")
+    ax.set_ylabel(r"mean $\delta$ (% of L), Eq. (13)")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "centerline_error.png", dpi=120)
+    plt.close(fig)
+    for r in rows:
+        print(f"L/W = {r['L_over_W']:.3g}  dW/L = {r['dW_over_L']:.3g}  mean {r['mean_error']:.3e}  max {r['max_error']:.3e}"
+              f"  {r['phase']} {r['message']}")
+    print(f"wrote {out / 'centerline_error.csv'} and {out / 'centerline_error.png'}")
+    return 0
 
 
 def cmd_simulate(args) -> int:
@@ -120,6 +238,10 @@ def main(argv=None) -> int:
     try:
         if args.command == "simulate":
             return cmd_simulate(args)
+        if args.command == "curvatures":
+            return cmd_curvatures(args)
+        if args.command == "centerline-error":
+            return cmd_centerline_error(args)
     except InputError as exc:
         sys.stderr.write(f"error: {exc}\n")
         return EXIT_BAD_INPUT

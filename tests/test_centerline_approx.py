@@ -74,3 +74,21 @@ def test_fig10_mean_error_grows_with_width_at_each_shear():
         errors = np.array([r["mean_error"] for r in mine])
         assert errors[0] > 5 * errors[-1]
         assert np.all(np.diff(errors) < 0)
+
+
+def test_centerline_error_command_writes_csv_and_png(tmp_path):
+    """`python -m ddg centerline-error` on two narrow coarse plates: CSV rows per (W/L, dW/L), a PNG."""
+    pytest.importorskip("matplotlib")
+    import csv
+
+    from ddg.cli import main
+
+    out = tmp_path / "e"
+    assert main(["centerline-error", "--width-ratios", "0.05,0.1", "--shear-ratios", "0.1", "--resolution", "300",
+                 "--out", str(out)]) == 0
+    with open(out / "centerline_error.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [float(r["L_over_W"]) for r in rows] == [20.0, 10.0]
+    assert float(rows[1]["mean_error"]) > float(rows[0]["mean_error"]) > 0
+    assert (out / "centerline_error.png").stat().st_size > 1000
+    assert main(["centerline-error", "--width-ratios", "1.5", "--out", str(tmp_path / "bad")]) == 2

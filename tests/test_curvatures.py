@@ -102,3 +102,19 @@ def test_plate_twist_at_the_inflection_falls_as_the_plate_thins():
         share = np.array([r["tau_inflection_over_max"] for r in mine])
         assert np.all(np.diff(twist) < 0) and np.all(np.diff(share) < 0)
         assert twist[-1] < 0.85 * twist[0]
+
+
+def test_curvatures_command_writes_csv_and_png(tmp_path):
+    """`python -m ddg curvatures`: one CSV row per station and requested shear, a PNG; bad input exits 2."""
+    pytest.importorskip("matplotlib")
+    from ddg.cli import main
+
+    out = tmp_path / "c"
+    assert main(["curvatures", "--model", "ribbon", "--shear-ratios", "0,0.2", "--resolution", "41",
+                 "--out", str(out)]) == 0
+    lines = (out / "curvatures.csv").read_text().splitlines()
+    assert lines[0].split(",") == list(CURVATURE_COLUMNS)
+    assert len(lines) == 1 + 2 * 39
+    assert (out / "curvatures.png").stat().st_size > 1000
+    assert main(["curvatures", "--shear-ratios", "0.3,x", "--out", str(tmp_path / "bad")]) == 2
+    assert main(["curvatures", "--model", "rod", "--zeta", "1", "--out", str(tmp_path / "bad")]) == 2

@@ -183,6 +183,84 @@ def straight_line_barrier(model, a: State, frames_a, b: State, frames_b, samples
             "peak_node_s_over_L": float(s_nodes[int(np.argmax(per_node))])}
 
 
+def _drag(model, start: State, frames_start, end_q: np.ndarray, t: np.ndarray, iterations: int, tolerance: float):
+    """Constrained minima along the line from start.q to end_q (twist angles in the start's
+    frames): at each fraction t the energy is minimised on the hyperplane through the point at
+    t normal to the line, continuing from the previous minimum. Energies, quartic parts, the
+    worst projected residual (EI2 / L^2 units)."""
+    free = model.free
+    c = (end_q - start.q)[free]
+    cc = float(c @ c)
+    rscale = model.residual_scale()[free]
+    energy, quartic = np.zeros(len(t)), np.zeros(len(t))
+    worst = 0.0
+    model.restore_frames(frames_start)
+    q = start.q.copy()
+    for k, tk in enumerate(t):
+        target = start.q + tk * (end_q - start.q)
+        q[free] += (c @ (target - q)[free]) / cc * c
+        model.commit(q)
+        ev = model.evaluate(q)
+        shift = 0.0
+        for _ in range(iterations):
+            g = ev.gradient[free]
+            residual = float(np.max(np.abs((g - (g @ c) / cc * c) / rscale)))
+            if residual < tolerance:
+                break
+            K = model.free_matrix(ev.hessian)
+            if not K.cholesky():
+                shift = max(0.25 * shift, 1e-8 * K.mean_diagonal())
+                while not K.shifted(shift).cholesky():
+                    shift *= 4.0
+                K = K.shifted(shift)
+            u, v = K.solve(g), K.solve(c)
+            dq = -(u - (c @ u) / (c @ v) * v)
+            alpha, accepted = 1.0, False
+            for _ in range(30):
+                trial = q.copy()
+                trial[free] += alpha * dq
+                ev_trial = model.evaluate(trial)
+                if ev_trial.energy <= ev.energy:
+                    accepted = True
+                    break
+                alpha *= 0.5
+            if not accepted:
+                break
+            q, ev = trial, ev_trial
+            model.commit(q, ev)
+        worst = max(worst, residual)
+        energy[k] = ev.energy
+        quartic[k] = ev.parts.get("sadowsky", 0.0)
+    return energy, quartic, worst
+
+
+def drag_barrier(model, a: State, frames_a, b: State, frames_b, samples: int = 21, iterations: int = 80,
+                 tolerance: float = 1e-7) -> dict:
+    """Energy barrier between equilibria a and b by the two-sided drag method: constrained minima
+    on hyperplanes normal to the straight line from a to b, followed from a forwards and from b
+    backwards (_drag). Each side stays in its own basin past the saddle, so the two energy curves
+    cross near it; the barrier estimate is min over t of the larger of the two (over E(a)).
+    Returns t, both curves and their quartic parts (over E(a)), the estimate, the t where it
+    sits, and the worst projected residual left."""
+    qb = same_state_in_frames(model, a.q, frames_a, b.q, frames_b)
+    qa_in_b = same_state_in_frames(model, b.q, frames_b, a.q, frames_a)
+    saved = model.save_frames()
+    t = np.linspace(0.0, 1.0, samples)
+    try:
+        e_fwd, q_fwd, w_fwd = _drag(model, a, frames_a, qb, t, iterations, tolerance)
+        e_bwd, q_bwd, w_bwd = _drag(model, b, frames_b, qa_in_b, t, iterations, tolerance)
+    finally:
+        model.restore_frames(saved)
+    e_bwd, q_bwd = e_bwd[::-1], q_bwd[::-1]  # backward fraction s = 1 - t
+    upper = np.maximum(e_fwd, e_bwd)
+    top = int(np.argmin(upper))
+    return {"t": t, "forward": e_fwd - e_fwd[0], "backward": e_bwd - e_fwd[0],
+            "forward_quartic": q_fwd - q_fwd[0], "backward_quartic": q_bwd - q_fwd[0],
+            "barrier": float(upper[top] - e_fwd[0]), "at_t": float(t[top]),
+            "quartic_at_top": float((q_fwd if e_fwd[top] >= e_bwd[top] else q_bwd)[top] - q_fwd[0]),
+            "worst_residual": max(w_fwd, w_bwd)}
+
+
 def _quartic_per_node(model, q):
     from .energies.rod_curvature import StencilGeometry
     from .energies.sadowsky import sadowsky_energy
@@ -198,14 +276,16 @@ def _quartic_per_node(model, q):
 
 
 def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float | None = None,
-                       resolution: int = 101, beyond: float = 0.05, options: ContinuationOptions | None = None) -> dict:
+                       resolution: int = 101, beyond: float = 0.05, options: ContinuationOptions | None = None,
+                       drag_samples: int = 0) -> dict:
     """Why the direct ribbon misses dW1 (all shears in units of L, energies in EI2 / L):
 
     - rod_dW1: the rod's pitchfork (lambda_min = 0 on its U branch, ddg.solve.thresholds);
     - rod_lambda_min / ribbon_lambda_min at rod_dW1: normalised lowest eigenvalues of both
       models' U states there (the ribbon's U branch followed directly from the flat strip);
     - at dW = rod_dW1 + beyond: the ribbon's U state (direct) and its US state (relaxed from the
-      rod's US+), their energies, H_mid, and the straight-line barrier between them.
+      rod's US+), their energies, H_mid, and the straight-line barrier between them (and, with
+      drag_samples > 0, the two-sided drag estimate of the barrier, ~20 s at 21 samples).
     """
     options = options or ContinuationOptions()
     L = strip.length
@@ -250,6 +330,7 @@ def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float
     rib_us = relax_from(ribbon, rod, rod_us, options)
     frames_us = ribbon.save_frames()
     barrier = straight_line_barrier(ribbon, rib_u, frames_u, rib_us, frames_us)
+    drag = drag_barrier(ribbon, rib_u, frames_u, rib_us, frames_us, drag_samples) if drag_samples else None
     ribbon.restore_frames(frames_u)
     row_u = observe(ribbon, rib_u, "shear")
     ribbon.restore_frames(frames_us)
@@ -269,4 +350,6 @@ def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float
         "straight_line_barrier_quartic_share": float(barrier["quartic"][barrier["top"]] / barrier["energy"][barrier["top"]])
         if barrier["energy"][barrier["top"]] > 0 else float("nan"),
         "barrier_peak_node_s_over_L": barrier["peak_node_s_over_L"],
+        **({} if drag is None else {"drag_barrier": drag["barrier"] / unit, "drag_barrier_quartic": drag["quartic_at_top"] / unit,
+                                     "drag_barrier_at_t": drag["at_t"], "drag_worst_residual": drag["worst_residual"]}),
     }

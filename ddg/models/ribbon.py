@@ -20,14 +20,22 @@ from .rod import RodModel
 
 __all__ = ["RibbonModel", "DEFAULT_ZETA_OVER_L"]
 
-#: Default regularisation length zeta / L of Eq. (A.5). The shear path of the ribbon at
-#: W/L = 1/20, dL/L = 1/2, M = 100 stops changing beyond zeta / L ~ 1e2 (H_mid within 1e-6 L
-#: from 1e3 to 1e8, tests/test_ribbon.py); the paper sets zeta = 1e8.
+#: Default regularisation length zeta / L of Eq. (A.5). At W/L = 1/20, dL/L = 1/2, M = 101 the
+#: shear path (H_mid up to dW/L = 0.5, direct and rod-initialised) differs from zeta / L = 1e8 by
+#: 1.7e-6 L at zeta / L = 10, 1.7e-8 L at 100 and less beyond (measured; tests/test_ribbon.py);
+#: the Sano-Wada value W^2 / (b sqrt 60) = 0.38 L shifts it by ~1e-3 L. The paper sets zeta = 1e8.
 DEFAULT_ZETA_OVER_L = 1e4
 
 
 class RibbonModel(RodModel):
-    """The DAR's DOFs and clamps with the Sadowsky energy (A.5); zeta in metres (default 1e4 L)."""
+    """The DAR's DOFs and clamps with the Sadowsky energy (A.5); zeta in metres (default 1e4 L).
+
+    Choose M not a multiple of 4: the clamped elastica's inflection points sit at s = L/4 and
+    3L/4, on node (M - 2)/4 + 1/2 when M = 0 mod 4, where kappa^(2) = 0 makes the quartic term a
+    maximum in kappa^(2) (Q_kk = -2 tau^4 / r^4): at M = 100 the symmetric U is a saddle from the
+    first shear step (lambda_min ~ -3e11, measured) and the path leaves it for a slightly
+    asymmetric state (2e-4 L at dW/L = 0.02). The default resolution is 101.
+    """
 
     name = "ribbon"
 

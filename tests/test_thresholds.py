@@ -40,10 +40,15 @@ def test_rod_thresholds_at_quarter_compression():
 def test_thresholds_do_not_depend_on_the_size_of_the_kick(narrow_rod):
     """The push off an unstable state only selects the branch; the thresholds come from
     stability, so a 100x smaller kick gives the same dW1 (to its 1e-4 tolerance) and dW2 (1e-3)."""
-    small = rod_path(0.5, 100, kick=1e-5).summary
-    reference = narrow_rod[100].summary
+    small_run = rod_path(0.5, 100, kick=1e-5)
+    small, reference = small_run.summary, narrow_rod[100].summary
     assert abs(small["dW1_over_L"] - reference["dW1_over_L"]) < 1e-4
     assert abs(small["dW2_over_L"] - reference["dW2_over_L"]) < 1e-3
+    # and the same branch: a push too small to leave the saddle within Newton's tolerance is
+    # grown (10x at a time), not replaced by an energy descent that picks either side
+    assert list(small_run.column("phase")) == list(narrow_rod[100].column("phase"))
+    h_small, h_reference = small_run.column("H_mid_over_L"), narrow_rod[100].column("H_mid_over_L")
+    assert np.max(np.abs(h_small - h_reference)) < 1e-7
 
 
 def test_phase_labels_follow_U_then_US_then_S(narrow_rod):

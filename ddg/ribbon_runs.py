@@ -238,8 +238,9 @@ def drag_barrier(model, a: State, frames_a, b: State, frames_b, samples: int = 2
                  tolerance: float = 1e-7) -> dict:
     """Energy barrier between equilibria a and b by the two-sided drag method: constrained minima
     on hyperplanes normal to the straight line from a to b, followed from a forwards and from b
-    backwards (_drag). Each side stays in its own basin past the saddle, so the two energy curves
-    cross near it; the barrier estimate is min over t of the larger of the two (over E(a)).
+    backwards (_drag). Each side rises in its own basin until it drops into the other; the
+    barrier estimate is min over t of the larger of the two basin parts (over E(a)), rough: the
+    drag method can jump between basins and miss the saddle.
     Returns t, both curves and their quartic parts (over E(a)), the estimate, the t where it
     sits, and the worst projected residual left."""
     qb = same_state_in_frames(model, a.q, frames_a, b.q, frames_b)
@@ -252,7 +253,16 @@ def drag_barrier(model, a: State, frames_a, b: State, frames_b, samples: int = 2
     finally:
         model.restore_frames(saved)
     e_bwd, q_bwd = e_bwd[::-1], q_bwd[::-1]  # backward fraction s = 1 - t
-    upper = np.maximum(e_fwd, e_bwd)
+    # each curve describes its own basin only until its first marked drop (over a tenth of its
+    # range: the drag fell into the other basin there); beyond it says nothing about the barrier
+    def basin(curve):
+        drops = np.flatnonzero(np.diff(curve) < -0.1 * np.ptp(curve))
+        out = curve.copy()
+        if drops.size:
+            out[drops[0] + 1:] = np.inf
+        return out
+
+    upper = np.maximum(basin(e_fwd), basin(e_bwd[::-1])[::-1])
     top = int(np.argmin(upper))
     return {"t": t, "forward": e_fwd - e_fwd[0], "backward": e_bwd - e_fwd[0],
             "forward_quartic": q_fwd - q_fwd[0], "backward_quartic": q_bwd - q_fwd[0],

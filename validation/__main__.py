@@ -1,0 +1,33 @@
+"""python -m validation report [--quick | --full] [--out DIR] [--jobs N] [--quiet]"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m validation")
+    sub = parser.add_subparsers(dest="command", required=True)
+    rep = sub.add_parser("report", help="run the models on the paper's scenes and write DIR/index.html, report.md")
+    group = rep.add_mutually_exclusive_group()
+    group.add_argument("--quick", dest="profile", action="store_const", const="quick",
+                       help="the default scenes with cached FEM gold data (a few minutes on 2 cores; default)")
+    group.add_argument("--full", dest="profile", action="store_const", const="full", help="every study (1-2 hours)")
+    group.add_argument("--smoke", dest="profile", action="store_const", const="smoke", help=argparse.SUPPRESS)
+    rep.add_argument("--out", default="out/validation", help="output directory (default out/validation)")
+    rep.add_argument("--jobs", type=int, default=2, help="worker processes for the model runs (default 2)")
+    rep.add_argument("--quiet", action="store_true", help="no progress bar")
+    args = parser.parse_args(argv)
+    if args.jobs < 1:
+        sys.stderr.write(f"error: --jobs = {args.jobs} must be >= 1\n")
+        return 2
+    from .report import build_report
+
+    summary = build_report(args.profile or "quick", args.out, jobs=args.jobs, progress=not args.quiet)
+    print(f"report: {args.out}/index.html ({summary['runs']} runs, {summary['report_wall_time_s']:.0f} s); "
+          f"claims failing: {summary['claims_failing'] or 'none'}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

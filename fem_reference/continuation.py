@@ -9,7 +9,9 @@ branch switching (paper section 4, App. B, E).
 * Each recorded step is reached by adaptive substeps: secant predictor from the last two
   converged states on the branch, Newton (solver.Solver) with the clamp increment lifted into
   the first correction (a tangent predictor); a failed substep is retried without the secant
-  predictor, then halved; a substep that converged in <= 4 iterations doubles the next one.
+  predictor, then halved; a substep that converged in <= 6 iterations doubles the next one.
+  A substep that still fails below 1e-4 L is past a fold: the state snaps to the next stable
+  equilibrium by Levenberg-Marquardt energy descent (solver.Solver.descend).
 * Stability after every recorded step: inertia of the constrained tangent (MUMPS L D L^T) and
   its lowest eigenvalue in the metric of shell.EIGEN_NORMALISATION (SLEPc shift-invert).
 * dW1: the symmetric mesh keeps the U branch exactly symmetric, so the path stays on U past the
@@ -52,13 +54,15 @@ class StepStats:
     newton_iterations: int = 0
     substeps: int = 0
     rejected: int = 0
+    snaps: int = 0
 
 
 @dataclass
 class ContinuationOptions:
     min_substep: float = 1e-7  # units of L
     max_substep: float = 0.05  # units of L
-    easy_iterations: int = 4
+    snap_substep: float = 1e-4  # below this failing substep, snap by energy descent (a fold)
+    easy_iterations: int = 6  # Newton's last, correction-size check adds one to the ~4 quadratic steps
     max_growth: float = 2.0
     perturbation: float = 1e-3  # starting amplitude of the branch-switch perturbation, units of L
     branch_switching: bool = True
@@ -135,6 +139,15 @@ class Stepper:
                     stats.rejected += 1
                     if self._predict(trial) is None:
                         break
+            if not ok and size <= self.options.snap_substep:
+                self.model.set_state(state0)
+                self.model.set_clamp(*trial)
+                try:
+                    its = self.solver.descend()
+                    ok = True
+                    stats.snaps += 1
+                except NewtonFailure:
+                    stats.rejected += 1
             if not ok:
                 self.model.set_state(state0)
                 self.model.set_clamp(*current)
@@ -155,6 +168,7 @@ class Stepper:
         return stats
 
     def restore(self, load, state, history: Branch | None = None) -> None:
+        self.substep = math.inf
         self.model.set_state(state)
         self.model.set_clamp(*load)
         if history is not None:
@@ -324,7 +338,7 @@ def switch_branch(stepper: Stepper, mode: np.ndarray, perturbation: float, growt
         history.append((a, mu, m.get_state()))
         if mu <= 0.0:
             break
-        if its <= 4:
+        if its <= 6:
             da = min(growth * da, max_increment)
     (a0, mu0, s0), (a1, mu1, s1) = history[-2], history[-1]
     w = mu0 / (mu0 - mu1)
@@ -340,6 +354,7 @@ def switch_branch(stepper: Stepper, mode: np.ndarray, perturbation: float, growt
         m.set_state(base)
         raise ContinuationFailure(f"branch switch at dW/L = {load[1]:.5f} reached {phase or 'flat'}, not a stable US")
     stepper.branch.reset(load, m.get_state())
+    stepper.substep = math.inf
     c.destroy()
     phi_vec.destroy()
     return iterations, a0 + w * (a1 - a0)

@@ -191,6 +191,68 @@ class Solver:
         self.total_iterations += opts.max_iterations
         raise NewtonFailure(f"bordered Newton: no convergence in {opts.max_iterations} iterations")
 
+    def descend(self, max_steps: int = 200, sigma: float = 1e-2) -> int:
+        """Snap to a stable equilibrium at the current clamp values: Levenberg-Marquardt steps
+        (K + sigma diag K) dq = -R, sigma raised until that matrix has no negative eigenvalue
+        (inertia) and the energy falls, lowered after each success; plain Newton is tried once
+        sigma is small. Used past a fold, where Newton from the last state cannot converge.
+        Returns iterations; raises NewtonFailure."""
+        m = self.model
+        x = m.q.vector
+        fem.petsc.set_bc(x, m.bcs)  # impose the clamp values exactly (the load step is tiny)
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        energy = m.energy()
+        its = 0
+        for _ in range(max_steps):
+            base = m.get_state()
+            b = self.assemble_residual()
+            K = self.assemble_tangent()
+            diag = K.getDiagonal()
+            while True:
+                A = K.copy()
+                shifted = diag.copy()
+                shifted.scale(1.0 + sigma)
+                A.setDiagonal(shifted)
+                self.inertia_ksp.setOperators(A)
+                self.inertia_ksp.setUp()
+                nneg, nzero, _ = self.inertia_ksp.getPC().getFactorMatrix().getInertia()
+                ok = nneg + nzero == 0
+                if ok:
+                    self.inertia_ksp.solve(b, self.dx)
+                    x.axpy(-1.0, self.dx)
+                    x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+                    new_energy = m.energy()
+                    ok = np.isfinite(new_energy) and new_energy < energy
+                A.destroy()
+                shifted.destroy()
+                if ok:
+                    energy = new_energy
+                    sigma = max(sigma / 3.0, 1e-8)
+                    break
+                m.set_state(base)
+                sigma *= 10.0
+                if sigma > 1e8:
+                    diag.destroy()
+                    raise NewtonFailure("descent: no energy decrease")
+            diag.destroy()
+            its += 1
+            if sigma < 1e-4:
+                state = m.get_state()
+                saved = self.options.max_iterations
+                self.options.max_iterations = 8
+                try:
+                    its += self.newton()
+                    if self.negative_eigenvalues() == 0:
+                        self.total_iterations += its
+                        return its
+                except NewtonFailure:
+                    pass
+                finally:
+                    self.options.max_iterations = saved
+                m.set_state(state)
+        self.total_iterations += its
+        raise NewtonFailure(f"descent: no stable equilibrium in {max_steps} steps")
+
     # --- stability -------------------------------------------------------------------------
     def negative_eigenvalues(self) -> int:
         """Number of negative eigenvalues of the constrained tangent at the current q

@@ -332,11 +332,11 @@ def speed_accuracy(results, study_specs, golds) -> tuple[list[dict], str]:
     if gold is not None:
         reference, ref_name = gold, "FEM gold"
     else:
-        plates = [(s, r) for s, r in runs if s.model == "plate"]
-        if not plates:
+        if not runs:
             return [], "none"
+        plates = [(s, r) for s, r in runs if s.model == "plate"] or runs
         spec, reference = max(plates, key=lambda t: t[0].resolution)
-        ref_name = f"finest plate ({spec.resolution} triangles; no FEM gold data for this scene)"
+        ref_name = f"finest {spec.model} run (resolution {spec.resolution}; no FEM gold data for this scene)"
     data = []
     for spec, run in runs:
         if run is reference:

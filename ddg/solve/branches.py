@@ -5,11 +5,11 @@ pseudo-arclength continuation in dW (ddg.solve.arclength), so folds are passed, 
 
 - U: the symmetric branch from the compressed state, without branch switching, to dW_max; it
   turns unstable at the pitchfork dW1 (lambda_min < 0).
-- US+ and US-: from the first unstable U state past dW1, a push along plus and minus the
-  critical mode and an energy descent give one stable state on each new branch; each is traced
-  backwards to the pitchfork (until the shape is U again) and forwards until it reaches the
-  point-symmetric S branch (the shape is S) or dW_max. Where US folds (the wide and the narrow
-  plate), the tracer goes round the fold and follows the unstable part back to S.
+- US+ and US-: from the U state next to dW1, the first arclength step goes along plus and minus
+  the critical mode at fixed dW (Keller's branch switching: no imperfection, no energy descent);
+  each branch is then traced until it reaches the point-symmetric S branch (the shape is S) or
+  dW_max. Where US folds (the narrow plate), the tracer goes round the fold and follows the
+  unstable part back to S.
 - S+ (S- with branch_sign = -1): from the first S state of the recorded path, backwards as far as
   the branch goes and forwards to dW_max.
 
@@ -18,13 +18,18 @@ vertical axis through the midpoint between the clamps), which the tests check po
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .arclength import ArclengthOptions, ArclengthTracer
-from .continuation import ContinuationOptions, PathFollower, State
+from .continuation import ContinuationOptions, State
+from .stability import lowest_modes
 from .thresholds import Snapshot
+
+
+#: Amplitude (root mean square of the shape change over L) of the first step off the pitchfork.
+PITCHFORK_STEP = 2e-3
 
 
 @dataclass
@@ -117,27 +122,36 @@ def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, sh
     lam = np.array([r["lambda_min"] for r in u.rows])
     crossing = np.nonzero((lam[:-1] > 0) & (lam[1:] <= 0))[0]
     if crossing.size:
-        k = int(crossing[0]) + 1
-        past = u.states[k]
-        past_frames = past.frames
-        for sign, name in ((1, "US+"), (-1, "US-")):
-            model.restore_frames(past_frames)
-            switcher = PathFollower(model, replace(options, branch_switching=True, branch_sign=sign))
-            seed = switcher._ensure_stable(replace(past, stable=False), 0)
-            if seed is None:
-                branches.append(Branch(name, end="no stable state found next to the pitchfork"))
+        # branch switching at the pitchfork (Keller): from the U state next to it, the first
+        # arclength step goes along plus or minus the critical mode at fixed dW (tangent (phi, 0));
+        # the corrector lands on US with that amplitude, at its own dW
+        k = int(crossing[0])
+        near = u.states[k] if abs(lam[k]) <= abs(lam[k + 1]) else u.states[k + 1]
+        _, modes = lowest_modes(model, near.evaluation.hessian, 1, vectors=True)
+        mode = np.zeros(model.n_dof)
+        mode[model.free] = modes[:, 0]
+        if model.mode_sign(mode, 0) < 0:
+            mode = -mode  # + raises the first half of the strip: the US+ side
+        # the mode made orthogonal to U's own tangent (U states at another dW differ from `near`
+        # by a field with a component along the mode: the symmetry centre moves with the clamp)
+        u_q, u_w = tracer.tangent(near, direction=direction)
+        phi = mode[model.free]
+        along = tracer._inner(phi, 0.0, u_q, u_w)
+        critical = (phi - along * u_q, -along * u_w)
+        for sign, name in ((1.0, "US+"), (-1.0, "US-")):
+            model.restore_frames(near.frames)
+            tangent = tracer._normalise(sign * critical[0], sign * critical[1])
+            # the US branches join S at the S branch's own pitchfork, and the tracer would go
+            # through the junction onto the mirror branch: stop where H_mid changes sign
+            first, _ = tracer.trace(near, tangent=tangent, shear_range=in_range, max_points=1,
+                                    initial_step=PITCHFORK_STEP)
+            if not first:
+                branches.append(Branch(name, end="no US state found next to the pitchfork"))
                 continue
-            seed_frames = model.save_frames()
-            # the US branches join U at dW1 and S at the S branch's own pitchfork, and the tracer
-            # would go through either junction onto the mirror branch: stop where the shape
-            # crosses the symmetric one (the asymmetry, resp. H_mid, changes sign)
-            back, _ = tracer.trace(seed, -direction, shear_range=in_range, max_points=60, initial_step=5e-4,
-                                   stop=_crosses(lambda s: _asymmetry(model, s), seed, "U", model))
-            model.restore_frames(seed_frames)
-            ahead, why = tracer.trace(seed, direction, shear_range=in_range,
-                                      stop=_crosses(lambda s: model.midpoint(s.q)[2], seed, "S", model))
-            tracer.newton_iterations += switcher.newton_iterations
-            finish(Branch(name, end=why), back[::-1] + [seed] + ahead)
+            ahead, why = tracer.trace(first[0], tangent=tracer.tangent(first[0], previous=tangent),
+                                      shear_range=in_range,
+                                      stop=_crosses(lambda st: model.midpoint(st.q)[2], first[0], "S", model))
+            finish(Branch(name, end=why), first + ahead)
     if first_s is not None:
         state, frames = first_s.state, first_s.frames
         model.restore_frames(frames)

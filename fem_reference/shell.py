@@ -4,13 +4,16 @@ Formulation (the pattern of FEniCSx-Shells' demo "nonlinear Naghdi clamped semic
 written here for a flat reference configuration and dolfinx 0.5.2):
 
 * Unknowns: displacement u (3 components) of the mid-surface phi = phi0 + u, phi0 = (x, y, 0),
-  and two rotation angles theta = (theta1, theta2) of the director (reference normal e3):
+  and the director's rotation from the reference normal e3 as an in-plane rotation vector,
+  omega = (-theta1, theta2, 0) (rotation about the axis omega by the angle r = |theta|):
 
-      d(theta) = (sin th2 cos th1, -sin th1, cos th2 cos th1)
+      d(theta) = (sinc(r) th2, -sinc(r) th1, cos r),   sinc(r) = sin(r)/r,
 
-  (rotation about e2 by th2 then about the rotated e1 by th1; singular only at th1 = +-pi/2, a
-  director lying along y, which the clamped strip never reaches: its normal turns about the
-  local generator, which stays near the x-z plane).
+  a unit vector for every theta, singular only at r = pi (a director turned upside down). The
+  two-angle form of the FEniCSx-Shells demo, d = (sin th2 cos th1, -sin th1, cos th2 cos th1),
+  is singular at th1 = +-pi/2, a director along y: the twisted middle of the US and S shapes
+  turns the normal that far, and Newton stalled there (dW/L ~ 0.36 at W/L = 1/6). Both forms
+  agree to second order in theta and exactly when th1 = 0 (the compressed U).
 * Strains (F = grad phi, 3 x 2; flat reference: a0 = I, b0 = 0):
   membrane eps = (F^T F - I)/2, bending kappa = -(F^T grad d + grad d^T F)/2, transverse
   shear gamma = F^T d.
@@ -70,10 +73,19 @@ EIGEN_NORMALISATION = ("lowest eigenvalue of the constrained tangent K v = lambd
                        "M = (1/W) int u.v dA over the displacement (rotations massless), times L^4/EI2")
 
 
+#: Below this r^2 sinc(r) and cos(r) are evaluated by their Taylor series in r^2 (no sqrt at 0).
+SMALL_ROTATION2 = 1e-6
+
+
 def director(theta):
-    """Director d(theta1, theta2) = R_e2(theta2) R_e1(theta1) e3 (flat reference, R0 = I)."""
-    return ufl.as_vector([ufl.sin(theta[1]) * ufl.cos(theta[0]), -ufl.sin(theta[0]),
-                          ufl.cos(theta[1]) * ufl.cos(theta[0])])
+    """Director d = R(omega) e3 for the in-plane rotation vector omega = (-theta1, theta2, 0):
+    (sinc(r) theta2, -sinc(r) theta1, cos r), r = |theta| (Rodrigues; flat reference, R0 = I)."""
+    r2 = ufl.dot(theta, theta)
+    small = ufl.lt(r2, SMALL_ROTATION2)
+    r = ufl.sqrt(ufl.conditional(small, SMALL_ROTATION2, r2))  # the exact branch is used only above it
+    sinc = ufl.conditional(small, 1.0 - r2 / 6.0 + r2**2 / 120.0, ufl.sin(r) / r)
+    cosine = ufl.conditional(small, 1.0 - r2 / 2.0 + r2**2 / 24.0, ufl.cos(r))
+    return ufl.as_vector([sinc * theta[1], -sinc * theta[0], cosine])
 
 
 @dataclass(frozen=True)

@@ -47,7 +47,7 @@ def _run(model: str, resolution: int, width_ratio: float) -> dict:
     # mark the eigenvalue time at the start of the threshold and branch phases
     import ddg.api as api
 
-    for name in ("_fill_thresholds", "_trace_branches"):
+    for name in ("fill_thresholds", "trace_all_branches"):
         inner = getattr(api, name)
 
         def marked(*args, _inner=inner, _name=name, **kwargs):
@@ -62,8 +62,8 @@ def _run(model: str, resolution: int, width_ratio: float) -> dict:
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     s = result.summary
     marks = dict((n, (t, c)) for n, t, c in eigen["marks"])
-    eig_path = marks.get("_fill_thresholds", (eigen["time_s"], eigen["calls"]))
-    eig_thr_end = marks.get("_trace_branches", (eigen["time_s"], eigen["calls"]))
+    eig_path = marks.get("fill_thresholds", (eigen["time_s"], eigen["calls"]))
+    eig_thr_end = marks.get("trace_all_branches", (eigen["time_s"], eigen["calls"]))
     threshold_s = s.get("threshold_wall_time_s") or 0.0
     branches_s = s.get("branches_wall_time_s") or 0.0
     return {

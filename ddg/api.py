@@ -96,7 +96,7 @@ class SimulationResult:
         return float(self.summary["scene"]["length"])
 
 
-class _Progress:
+class ProgressBar:
     """A one-line progress bar on stderr when it is a terminal."""
 
     def __init__(self, total: int, enabled: bool):
@@ -116,7 +116,7 @@ class _Progress:
             sys.stderr.write("\n")
 
 
-def _track_brackets(brackets: dict, model, state, phase: str) -> None:
+def track_brackets(brackets: dict, model, state, phase: str) -> None:
     """Remember the recorded states that bracket the phase changes U -> US and US -> S."""
     from .solve.thresholds import Snapshot
 
@@ -131,7 +131,7 @@ def _track_brackets(brackets: dict, model, state, phase: str) -> None:
         brackets["first_s"] = Snapshot.take(model, state)
 
 
-def _fill_thresholds(summary: dict, model, options, brackets: dict) -> None:
+def fill_thresholds(summary: dict, model, options, brackets: dict) -> None:
     from .solve.thresholds import shear_thresholds
 
     t0 = time.perf_counter()
@@ -143,7 +143,7 @@ def _fill_thresholds(summary: dict, model, options, brackets: dict) -> None:
     summary["threshold_wall_time_s"] = time.perf_counter() - t0
 
 
-def _trace_branches(summary: dict, model, options, compressed, shear_max: float, brackets: dict) -> list[dict]:
+def trace_all_branches(summary: dict, model, options, compressed, shear_max: float, brackets: dict) -> list[dict]:
     """Every branch of the shear stage by pseudo-arclength (ddg.solve.branches); its rows."""
     from .solve.branches import trace_branches
 
@@ -271,7 +271,7 @@ def simulate(
 
     rows: list[dict] = []
     centerlines: list[np.ndarray] = []
-    progress_bar = _Progress(protocol.compression_steps + protocol.shear_steps + 1, progress)
+    progress_bar = ProgressBar(protocol.compression_steps + protocol.shear_steps + 1, progress)
     summary = base_summary(model, strip, protocol, resolution, instance)
     t0 = time.perf_counter()
     state = None
@@ -284,7 +284,7 @@ def simulate(
         row = observe(instance, state, stage, options.eigenvalues)
         rows.append(row)
         if stage == "shear" and thresholds:
-            _track_brackets(brackets, instance, state, row["phase"])
+            track_brackets(brackets, instance, state, row["phase"])
         centerlines.append(instance.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
         if writer is not None:
             writer.write(instance.positions(state.q), step=len(rows) - 1, dL_over_L=row["dL_over_L"],
@@ -315,9 +315,9 @@ def simulate(
     finally:
         progress_bar.close()
         if thresholds and options.eigenvalues and state is not None and summary["message"] != "interrupted":
-            _fill_thresholds(summary, instance, options, brackets)
+            fill_thresholds(summary, instance, options, brackets)
             if branches and compressed is not None and dW != 0.0:
-                branch_rows = _trace_branches(summary, instance, options, compressed, dW, brackets)
+                branch_rows = trace_all_branches(summary, instance, options, compressed, dW, brackets)
         summary["newton_iterations"] = follower.newton_iterations
         summary["folds_dW_over_L"] = _distinct([abs(f) / L for f in follower.folds], 1e-4)
         summary["wall_time_s"] = time.perf_counter() - t0

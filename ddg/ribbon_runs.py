@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .api import (CENTERLINE_STATIONS, DEFAULT_RESOLUTION, SimulationResult, _fill_thresholds, _Progress,
-                  _track_brackets, base_summary)
-from .geometry.frames import cross, parallel_transport, rowdot
+from .api import (CENTERLINE_STATIONS, DEFAULT_RESOLUTION, SimulationResult, fill_thresholds, ProgressBar,
+                  track_brackets, base_summary)
+from .geometry.frames import cross, rowdot
 from .geometry.strip import InputError, LoadingProtocol, Strip
 from .io import write_path_csv
 from .models.ribbon import RibbonModel
@@ -86,7 +86,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     summary.update(ribbon_init=init, zeta=ribbon.zeta, zeta_over_L=ribbon.zeta / L)
     rows, rod_rows, centerlines = [], [], []
     brackets = {"last_u": None, "first_us": None, "last_us": None, "first_s": None}
-    bar = _Progress(protocol.compression_steps + protocol.shear_steps + 1, progress)
+    bar = ProgressBar(protocol.compression_steps + protocol.shear_steps + 1, progress)
     relax_iterations = 0
     t0 = time.perf_counter()
     state = None
@@ -102,7 +102,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
         row = observe(ribbon, state, stage, options.eigenvalues)
         rows.append(row)
         if stage == "shear" and thresholds and rod is None:
-            _track_brackets(brackets, ribbon, state, row["phase"])
+            track_brackets(brackets, ribbon, state, row["phase"])
         centerlines.append(ribbon.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
         bar.update(f"{stage} dL/L={row['dL_over_L']:.4f} dW/L={row['dW_over_L']:.4f}")
 
@@ -125,7 +125,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     finally:
         bar.close()
         if thresholds and options.eigenvalues and state is not None and rod is None:
-            _fill_thresholds(summary, ribbon, options, brackets)
+            fill_thresholds(summary, ribbon, options, brackets)
         summary["newton_iterations"] = follower.newton_iterations + relax_iterations
         summary["wall_time_s"] = time.perf_counter() - t0
         summary["recorded_steps"] = len(rows)

@@ -28,8 +28,7 @@ branch switching (paper section 4, App. B, E).
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -289,8 +288,6 @@ def switch_branch(stepper: Stepper, mode: np.ndarray, perturbation: float, growt
     Newton falls back to U: the linear mode stretches the mid-surface at finite amplitude).
     Returns (iterations, amplitude) or raises ContinuationFailure unless the result is US with
     no negative eigenvalue."""
-    from petsc4py import PETSc
-
     m, solver = stepper.model, stepper.solver
     base = m.get_state()
     load = stepper.load
@@ -362,20 +359,34 @@ def switch_branch(stepper: Stepper, mode: np.ndarray, perturbation: float, growt
 
 def locate_dw2(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW2_TOLERANCE):
     """Smallest dW (to tol) at which the stable path, followed from the last US state `low`,
-    is point-symmetric (phase S). Returns (dW2, newton_iterations)."""
+    is point-symmetric (phase S). Returns (dW2, newton_iterations).
+
+    The US branch either reaches S continuously (the phase at the bisection point decides) or
+    ends in a fold, past which Newton from the US side cannot converge: the stable path snaps to
+    S there, so a failed step also counts as past dW2. No energy descent during the bisection
+    (on the shell it takes hundreds of Levenberg-Marquardt steps per snap)."""
     load_a, state_a, history_a = low
     a, b = float(load_a[1]), float(high_shear)
     iterations = 0
-    while b - a > tol:
-        mid = 0.5 * (a + b)
-        stepper.restore(load_a, state_a, history_a)
-        stats = stepper.advance((load_a[0], mid))
-        iterations += stats.newton_iterations
-        phase, _, _ = phase_of(stepper.model, stepper.model.positions())
-        if phase.startswith("S"):
-            b = mid
-        else:
-            a = mid
-            load_a, state_a = np.array(stepper.load), stepper.model.get_state()
-            history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
+    saved = stepper.options
+    stepper.options = replace(saved, snap_substep=0.0, min_substep=max(saved.min_substep, 1e-2 * tol))
+    try:
+        while b - a > tol:
+            mid = 0.5 * (a + b)
+            stepper.restore(load_a, state_a, history_a)
+            try:
+                stats = stepper.advance((load_a[0], mid))
+            except ContinuationFailure:
+                b = mid  # beyond the fold of US
+                continue
+            iterations += stats.newton_iterations
+            phase, _, _ = phase_of(stepper.model, stepper.model.positions())
+            if phase.startswith("S"):
+                b = mid
+            else:
+                a = mid
+                load_a, state_a = np.array(stepper.load), stepper.model.get_state()
+                history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
+    finally:
+        stepper.options = saved
     return b, iterations

@@ -206,8 +206,6 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
         for k in range(1, n_shear + 1):
             t0 = time.perf_counter()
             target = (dL, dW_end * k / protocol.shear_steps)
-            history = Branch(list(stepper.branch.loads), list(stepper.branch.states))
-            prev_load, prev_state = stepper.load, model.get_state()
             its = stepper.advance(target).newton_iterations
             obs = record("shear", its, t0)
             row = obs.row

@@ -54,9 +54,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="at the pitchfork follow US+ and then S+ (default) or US- and S-")
     sim.add_argument("--no-thresholds", action="store_true",
                      help="skip locating dW1 and dW2 from stability after the path (summary keys stay null)")
-    sim.add_argument("--no-branches", action="store_true",
-                     help="skip tracing every branch (U, US+, US-, S) by pseudo-arclength after the path "
-                          "(OUT/branches.csv)")
+    branch_group = sim.add_mutually_exclusive_group()
+    branch_group.add_argument("--branches", dest="branches", action="store_true", default=None,
+                              help="trace every branch (U, US+, US-, S) by pseudo-arclength after the path into "
+                                   "OUT/branches.csv (default for the rod; the plate's costs more "
+                                   "than its path)")
+    branch_group.add_argument("--no-branches", dest="branches", action="store_false", help="do not trace the branches")
     sim.add_argument("--no-branch-switching", action="store_true",
                      help="stay on the branch the path starts on, even where it is unstable")
     sim.add_argument("--solver", choices=("static", "dynamic"), default="static",
@@ -219,7 +222,7 @@ def cmd_simulate(args) -> int:
         result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
                           progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options,
                           mesh=args.mesh, frames=args.frames, thresholds=not args.no_thresholds,
-                          branches=not args.no_branches)
+                          branches=args.branches)
     s = result.summary
     if not args.quiet:
         keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",

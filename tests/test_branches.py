@@ -10,7 +10,7 @@ import ddg
 def run(model, resolution, shear_ratio, shear_steps):
     strip = ddg.Strip.from_ratios(0.05, 0.5)
     protocol = ddg.LoadingProtocol(0.5, shear_ratio=shear_ratio, compression_steps=20, shear_steps=shear_steps)
-    result = ddg.simulate(strip, protocol, model=model, resolution=resolution)
+    result = ddg.simulate(strip, protocol, model=model, resolution=resolution, branches=True)
     assert result.converged, result.summary["message"]
     return result
 
@@ -111,8 +111,9 @@ def test_narrow_plate_US_branch_folds_and_the_path_snaps_to_S(narrow_plate):
     fold, and S turns stable just before it (measured 0.4517, 0.4519, 0.4511 at 600 triangles).
     (A second, tiny fold pair at dW/L = 0.3745-0.3747 is a short unstable stretch inside US.)"""
     s = narrow_plate.summary
-    assert len(s["folds_dW_over_L"]) == 1  # met by the recorded path
-    fold = s["folds_dW_over_L"][0]
+    # met by the recorded path: the small fold inside US (0.3745) and the end of US
+    assert len(s["folds_dW_over_L"]) == 2 and s["folds_dW_over_L"][0] == pytest.approx(0.3745, abs=1e-3)
+    fold = s["folds_dW_over_L"][-1]
     assert fold == pytest.approx(s["dW2_over_L"], abs=1e-3)
     assert s["dW2_S_stable_over_L"] < fold
     dw, lam = branch(narrow_plate, "US+", "dW_over_L"), branch(narrow_plate, "US+", "lambda_min")

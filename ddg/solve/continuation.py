@@ -149,14 +149,17 @@ class PathFollower:
             # near singular points (thresholds) Newton converges only linearly: allow it more iterations
             hard = self.substep <= self.options.jump_substep
             new = self._step(state, *load, patient=hard)
-            if new is None and hard and load[0] == state.compression and self._fold_tried_at is not state:
-                self._fold_tried_at = state  # once per state: a second failure is not a fold
-                # Newton stalls near a limit point of dW: pseudo-arclength goes round it, or past
-                # the hard spot to the target (then new is the equilibrium at the target)
-                new = self._across_fold(state, *load)
-            if new is None and self.options.branch_switching and hard:
+            if new is None and hard and self.options.branch_switching:
                 # the branch has ended (a fold): let the strip snap to the nearest stable state
                 new = self._jump(state, *load)
+                if new is not None:
+                    self.folds.append(state.shear)  # the branch ended within this substep
+            if new is None and hard and load[0] == state.compression and self._fold_tried_at is not state:
+                self._fold_tried_at = state  # once per state: a second failure is not a fold
+                # Newton stalls near a limit point of dW (or energy descent slid too slowly to
+                # converge): pseudo-arclength goes round the fold and, with switching, follows the
+                # unstable part to the branch the strip snaps to; or past a hard spot to the target
+                new = self._across_fold(state, *load)
             if new is None:
                 self._easy_streak = 0
                 self.substep *= 0.5

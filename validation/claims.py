@@ -35,7 +35,7 @@ CLAIMS = {c.key: c for c in (
     Claim("rod_vs_plate_narrow_U", "rod vs plate at W/L = 1/20, dL/L = 1/2: largest H_mid difference/L on the "
           "U branch (dW up to 0.02 below the first dW1)", 0.01),
     Claim("plate_vs_fem_curve", "plate vs FEM at W/L = 1/6, dL/L = 1/2: largest H_mid difference/L over the "
-          "shear, 0.02 away from the FEM thresholds", 0.01),
+          "shear, 0.02 away from either model's thresholds", 0.01),
     Claim("plate_vs_fem_dW1", "plate vs FEM at W/L = 1/6, dL/L = 1/2: dW1 difference/L", 0.02),
     Claim("rod_thresholds_paper", "rod at W/L = 1/20 (dL/L = 1/2 and 1/4): largest difference of dW1, dW2 from the paper, /L", 0.02),
     Claim("plate_dW1_paper_sixth", "plate at W/L = 1/6, dL/L = 1/2: dW1/L - 0.27, absolute", 0.03),
@@ -66,9 +66,11 @@ def u_branch_difference(run, other) -> float:
 
 
 def curve_difference_away_from_thresholds(run, reference) -> float:
-    s = reference.summary
+    """Max |H_mid difference|/L, 0.02 away from either run's dW1 and dW2 (near a threshold a
+    small shift of it is a large difference in H_mid: sqrt(dW - dW1) growth, the snap at dW2)."""
+    exclude = [s.get(k) for s in (run.summary, reference.summary) for k in ("dW1_over_L", "dW2_over_L")]
     return curve_error(_shear(run, "dW_over_L"), _shear(run, "H_mid_over_L"), _shear(reference, "dW_over_L"),
-                       _shear(reference, "H_mid_over_L"), exclude=[s.get("dW1_over_L"), s.get("dW2_over_L")])
+                       _shear(reference, "H_mid_over_L"), exclude=exclude)
 
 
 def threshold_difference(run, reference, key: str = "dW1_over_L") -> float | None:

@@ -28,7 +28,7 @@ from ddg.io import atomic_write_text
 DEFAULT_CASES = ("rod:100", "plate:2000")
 
 
-def _run(model: str, resolution: int, width_ratio: float) -> dict:
+def _run(model: str, resolution: int, width_ratio: float, branches=None) -> dict:
     import ddg
     from ddg.solve import banded
 
@@ -58,7 +58,7 @@ def _run(model: str, resolution: int, width_ratio: float) -> dict:
     strip = ddg.Strip.from_ratios(width_ratio, 0.5)
     protocol = ddg.LoadingProtocol(0.5, compression_steps=40, shear_steps=120)
     t0, c0 = time.perf_counter(), time.process_time()
-    result = ddg.simulate(strip, protocol, model=model, resolution=resolution)
+    result = ddg.simulate(strip, protocol, model=model, resolution=resolution, branches=branches)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     s = result.summary
     marks = dict((n, (t, c)) for n, t, c in eigen["marks"])
@@ -87,10 +87,10 @@ def _child(queue, *args):
     queue.put(_run(*args))
 
 
-def run_case(model: str, resolution: int, width_ratio: float) -> dict:
+def run_case(model: str, resolution: int, width_ratio: float, branches=None) -> dict:
     ctx = mp.get_context("spawn")
     queue = ctx.Queue()
-    proc = ctx.Process(target=_child, args=(queue, model, resolution, width_ratio))
+    proc = ctx.Process(target=_child, args=(queue, model, resolution, width_ratio, branches))
     proc.start()
     record = queue.get()
     proc.join()
@@ -119,8 +119,9 @@ def markdown(records: list[dict]) -> str:
     lines += ["", "load = 1-minute load average at the end of the run (above 2 on this 2-core machine, other "
               "processes shared the cores and the times are inflated).", ""]
     for r in records:
-        lines.append(f"- {r['model']} {r['resolution']}: {r['message']}; branch points {r['branch_points']}; "
-                     f"folds met by the path at dW/L = {r['folds_dW_over_L']}")
+        folds = ", ".join(f"{f:.4f}" for f in (r.get("folds_dW_over_L") or []))
+        lines.append(f"- {r['model']} {r['resolution']}: {r['message']}; branch points {r['branch_points'] or 'not traced'}; "
+                     f"snaps of the path (folds) at dW/L = [{folds}]" + (f". {r['note']}" if r.get("note") else ""))
     return "\n".join(lines) + "\n"
 
 
@@ -129,16 +130,20 @@ def main(argv=None) -> None:
     parser.add_argument("--cases", nargs="+", default=list(DEFAULT_CASES), help="model:resolution, e.g. rod:100")
     parser.add_argument("--width-ratio", type=float, nargs="+", default=[0.05, 1 / 6],
                         help="W/L for the rod (first) and the plate (last)")
+    parser.add_argument("--branches", choices=("default", "on", "off"), default="default",
+                        help="trace the branches (library default: rod yes, plate no)")
+    parser.add_argument("--append", action="store_true", help="add to the existing results instead of replacing them")
     parser.add_argument("--out", default="benchmarks/results")
     args = parser.parse_args(argv)
-    records = []
+    branches = {"default": None, "on": True, "off": False}[args.branches]
+    out = Path(args.out)
+    records = json.loads((out / "stability_cost.json").read_text()) if args.append and (out / "stability_cost.json").exists() else []
     for case in args.cases:
         model, resolution = case.split(":")
         width = args.width_ratio[0] if model == "rod" else args.width_ratio[-1]
-        record = run_case(model, int(resolution), width)
+        record = run_case(model, int(resolution), width, branches)
         print(json.dumps(record), flush=True)
         records.append(record)
-    out = Path(args.out)
     atomic_write_text(out / "stability_cost.json", json.dumps(records, indent=2) + "\n")
     atomic_write_text(out / "stability_cost.md", markdown(records))
 

@@ -116,7 +116,8 @@ def test_claim_narrow_plate_and_rod_agree_on_U(narrow_rod):
 
 @pytest.fixture(scope="module")
 def plate_sixth():
-    return simulate("plate", 1 / 6, 1 / 2, 1000)
+    """The report's quick scene: the plate at its default 2000 triangles."""
+    return simulate("plate", 1 / 6, 1 / 2, 2000)
 
 
 @pytest.mark.slow

@@ -34,12 +34,14 @@ def quick() -> Profile:
     return Profile(
         name="quick",
         shear_curves=[(c, w) for c in COMPRESSIONS for w in WIDTHS_PAPER],
-        models={"rod": 100, "plate": 1000, "ribbon": 101},
+        # the plate at its default 2000 triangles: at 1000 its W/L = 1/6 strip never reaches S
+        # (US with H_mid/L ~ 0.03-0.06 to dW_max), against S from dW/L = 0.443 at 2000
+        models={"rod": 100, "plate": 2000, "ribbon": 101},
         plate_scenes=[(1 / 2, 1 / 20), (1 / 2, 1 / 6)],
         ribbon_scenes=[(1 / 2, 1 / 20)],
         phase_widths=(),
         convergence={"rod": (50, 100, 200)},
-        speed={"rod": (50, 100, 200), "plate": (500, 1000)},
+        speed={"rod": (50, 100, 200), "plate": (500, 1000, 2000)},
         shear_steps=60,
     )
 

@@ -85,3 +85,37 @@ def write_index(out: Path) -> None:
                        "resolved_up_to_dW_over_L": s["resolved_up_to_dW_over_L"]}
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "index.json", json.dumps(index, indent=2) + "\n")
+    write_readme(out, index)
+
+
+README_HEAD = """# FEM gold data (fem_reference, nonlinear Naghdi shell)
+
+Regenerate all scenes (one at a time, complete ones are skipped; about 1-2 hours on 2 cores):
+
+    .venv/bin/python -m fem_reference gold --out data/fem_gold
+
+One scene: `--only dL0.5_W0.1667` (names dL<dL/L>_W<W/L>: dL0.5_W0.05, dL0.5_W0.08333,
+dL0.5_W0.1667, dL0.5_W0.3333, dL0.5_W0.5, dL0.25_W0.05, ...). Default mesh: 60 elements along L,
+across W near-isotropic and at least 60 W/L. Each folder holds path.csv, summary.json and
+centerline.csv (the DDG output contract); `index.json` lists what exists. Mesh convergence of the
+W/L = 1/6, dL/L = 1/2 scene (60/90/120 elements along L): ../fem_convergence/dL0.5_W0.1667/convergence.md
+(at 60 elements dW1/L is about 0.012 low and H_mid on US up to 0.024 L off the extrapolated curve).
+
+## What exists (written by the gold command)
+
+| scene | elements along L | triangles | unknowns | H_mid/L compressed | dW1/L | dW2/L | complete | wall time s |
+|---|---:|---:|---:|---:|---:|---:|---|---:|
+"""
+
+
+def write_readme(out: Path, index: dict) -> None:
+    """OUT/README.md: how to regenerate, and the table of the scenes that exist."""
+    missing = [name for name, _, _ in scenes() if name not in index]
+    fmt = lambda v: "-" if v is None else f"{v:.4f}"  # noqa: E731
+    rows = [f"| {name} | {e['resolution']} | {e['triangles']} | {e['n_dof']} | {e['H_mid_over_L_compressed']:.6f} "
+            f"| {fmt(e['dW1_over_L'])} | {fmt(e['dW2_over_L'])} | {'yes' if e['converged'] else 'no: ' + e['message']} "
+            f"| {e['wall_time_s']:.0f} |" for name, e in index.items()]
+    text = README_HEAD + "\n".join(rows) + "\n"
+    if missing:
+        text += f"\nNot yet run (one command away, see above): {', '.join(missing)}.\n"
+    atomic_write_text(out / "README.md", text)

@@ -72,7 +72,6 @@ def test_compression_matches_clamped_elastica(tmp_path, compression_ratio):
     assert header[len(PATH_COLUMNS): len(PATH_COLUMNS) + 4] == list(EXTRA_COLUMNS[:4])
     assert rows[-1]["phase"] == "U" and rows[0]["stage"] == "compression"
     summary = json.loads((tmp_path / "summary.json").read_text())
-    from ddg.api import base_summary  # noqa: F401  (the keys every model writes)
 
     for key in ("model", "scene", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L",
                 "dW2_S_stable_over_L", "threshold_wall_time_s", "n_dof", "n_free_dof", "newton_iterations",

@@ -124,3 +124,16 @@ def test_plate_dW1_falls_monotonically_with_width():
         assert result.summary["dW1_over_L"] is not None, result.summary["message"]
         values.append(result.summary["dW1_over_L"])
     assert np.all(np.diff(values) < 0), values
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("width_ratio, triangles, paper", [(1 / 6, 2000, 0.27), (1 / 2, 6000, 0.17)])
+def test_plate_dW1_near_the_paper_for_wide_plates(width_ratio, triangles, paper):
+    """Paper (Fig. 6c-d, read by eye from dynamic runs): dW1/L ~ 0.27 at W/L = 1/6 and 0.17 at 1/2.
+    Measured from stability: 0.251 at W/L = 1/6 (2100 triangles); at W/L = 1/2 dW1 converges
+    slowly, 0.117, 0.133, 0.146 at 1554, 1968, 6132 triangles, so the wide plate needs the finer
+    mesh (at the default 2000 triangles it is 0.037 below the paper's value)."""
+    strip = ddg.Strip.from_ratios(width_ratio, 0.5)
+    protocol = ddg.LoadingProtocol(0.5, shear_ratio=paper + 0.05, compression_steps=20, shear_steps=30)
+    result = ddg.simulate(strip, protocol, model="plate", resolution=triangles, branches=False)
+    assert result.summary["dW1_over_L"] == pytest.approx(paper, abs=0.03)

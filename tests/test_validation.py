@@ -134,14 +134,13 @@ def _gold_sixth():
 
 @pytest.mark.slow
 def test_claim_plate_and_fem_agree_on_dW1(plate_sixth):
-    """Measured 0.2509 (plate, 2000 triangles) vs 0.2564 (FEM, 60 elements along L)."""
+    """Measured 0.2509 (plate, 2000 triangles) vs 0.2614 (FEM, 90 x 15 elements)."""
     holds("plate_vs_fem_dW1", C.threshold_difference(plate_sixth, _gold_sixth()))
 
 
 @pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="known disagreement, reported as failing in the validation report: "
-                   "plate (2000 triangles) vs FEM (60 elements along L) differ by up to 0.018 L on the US branch "
-                   "(dW/L 0.33-0.41) and reach S at 0.443 vs 0.466 (plate 4000 triangles: 0.0106 L up to "
-                   "dW/L = 0.35, S from 0.413); the FEM's own mesh error on US is 0.024 L at 60 elements")
+                   "plate (2000 triangles) vs FEM (90 x 15 elements) differ by 0.011 L on the US branch, S at "
+                   "0.443 vs 0.434; the FEM itself moves by 0.021 L between 60 and 90 elements there")
 def test_claim_plate_and_fem_agree_on_the_H_mid_curve(plate_sixth):
     holds("plate_vs_fem_curve", C.curve_difference_away_from_thresholds(plate_sixth, _gold_sixth()))

@@ -11,11 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..energies.rod_curvature import StencilGeometry
 from ..energies.sadowsky import check_zeta, sadowsky_energy
-from ..energies.stretch import stretching_energy, two_node_blocks
 from ..geometry.strip import Strip
-from .base import Evaluation
 from .rod import RodModel
 
 __all__ = ["RibbonModel", "DEFAULT_ZETA_OVER_L"]
@@ -43,31 +40,10 @@ class RibbonModel(RodModel):
         super().__init__(strip, nodes)
         self.zeta = check_zeta(DEFAULT_ZETA_OVER_L * strip.length if zeta is None else zeta)
 
-    def evaluate(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
+    def curvature_energy(self, geom, tau: np.ndarray, gradient: bool, hessian: bool):
+        """The Sadowsky energy (Eq. A.5) in place of the rod's bending and twisting."""
         s = self.strip
-        x = q[self.node_dofs]
-        t, d1, m1, m2, m_ref = self.frames(q)
-        edges = x[1:] - x[:-1]
-        e_s, g_s, h_s = stretching_energy(edges, self.rest_edge_lengths, self.stretch_stiffness,
-                                          gradient=gradient, hessian=hessian)
-        geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
-        theta = q[self.theta_dofs]
-        tau = theta[1:] - theta[:-1] + m_ref
         _, parts, g_r, h_r = sadowsky_energy(geom, tau, self.voronoi_lengths, s.bending_stiffness,
                                              s.geodesic_bending_stiffness, s.twisting_stiffness, self.zeta,
                                              gradient=gradient, hessian=hessian)
-        totals = {"stretching": float(e_s.sum()), **{k: float(v.sum()) for k, v in parts.items()}}
-        out = Evaluation(energy=sum(totals.values()), parts=totals, frames=(t, d1, m_ref))
-        if not gradient:
-            return out
-        grad = np.zeros(self.n_dof)
-        g_edge, h_edge = two_node_blocks(g_s, h_s if hessian else np.zeros((len(edges), 3, 3)))
-        grad += np.bincount(self._edge_index.ravel(), weights=g_edge.ravel(), minlength=self.n_dof)
-        grad += np.bincount(self._stencil_index.ravel(), weights=g_r.ravel(), minlength=self.n_dof)
-        out.gradient = grad
-        if hessian:
-            h7 = np.zeros((len(edges), 7, 7))
-            idx = np.r_[0, 1, 2, 4, 5, 6]
-            h7[:, idx[:, None], idx[None, :]] = h_edge
-            out.hessian = self._assembler.assemble([h7, h_r])
-        return out
+        return {k: float(v.sum()) for k, v in parts.items()}, g_r, h_r

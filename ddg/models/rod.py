@@ -145,7 +145,6 @@ class RodModel(BandedModel):
 
     # ------------------------------------------------------------------ energy
     def evaluate(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
-        s = self.strip
         x = q[self.node_dofs]
         t, d1, m1, m2, m_ref = self.frames(q)
         edges = x[1:] - x[:-1]
@@ -154,6 +153,27 @@ class RodModel(BandedModel):
         geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
         theta = q[self.theta_dofs]
         tau = theta[1:] - theta[:-1] + m_ref
+        parts, g_stencil, h_stencil = self.curvature_energy(geom, tau, gradient, hessian)
+        parts = {"stretching": float(e_s.sum()), **parts}
+        out = Evaluation(energy=sum(parts.values()), parts=parts, frames=(t, d1, m_ref))
+        if not gradient:
+            return out
+        grad = np.zeros(self.n_dof)
+        g_edge, h_edge = two_node_blocks(g_s, h_s if hessian else np.zeros((len(edges), 3, 3)))
+        grad += np.bincount(self._edge_index.ravel(), weights=g_edge.ravel(), minlength=self.n_dof)
+        grad += np.bincount(self._stencil_index.ravel(), weights=g_stencil.ravel(), minlength=self.n_dof)
+        out.gradient = grad
+        if hessian:
+            h7 = np.zeros((len(edges), 7, 7))
+            idx = np.r_[0, 1, 2, 4, 5, 6]
+            h7[:, idx[:, None], idx[None, :]] = h_edge
+            out.hessian = self._assembler.assemble([h7, h_stencil])
+        return out
+
+    def curvature_energy(self, geom: StencilGeometry, tau: np.ndarray, gradient: bool, hessian: bool):
+        """Bending (Eq. 4) and twisting energies of the interior nodes: totals per part, and the
+        per-stencil gradients (S, 11) and Hessians (S, 11, 11) where asked (the ribbon overrides it)."""
+        s = self.strip
         if hessian and gradient:
             e_b, e_t, g_b, g_t, h_bt = self._bend_twist_fused(geom, tau)
             h_b, h_t = h_bt, 0.0
@@ -162,22 +182,8 @@ class RodModel(BandedModel):
                                            s.geodesic_bending_stiffness, gradient=gradient, hessian=False)
             g_tau = twist_derivatives(geom, hessian=False)[0] if gradient else None
             e_t, g_t, h_t = twisting_energy(tau, self.voronoi_lengths, s.twisting_stiffness, g_tau, None)
-        parts = {"stretching": float(e_s.sum()), "bending": float(e_b.sum()), "twisting": float(e_t.sum())}
-        out = Evaluation(energy=parts["stretching"] + parts["bending"] + parts["twisting"], parts=parts,
-                         frames=(t, d1, m_ref))
-        if not gradient:
-            return out
-        grad = np.zeros(self.n_dof)
-        g_edge, h_edge = two_node_blocks(g_s, h_s if hessian else np.zeros((len(edges), 3, 3)))
-        grad += np.bincount(self._edge_index.ravel(), weights=g_edge.ravel(), minlength=self.n_dof)
-        grad += np.bincount(self._stencil_index.ravel(), weights=(g_b + g_t).ravel(), minlength=self.n_dof)
-        out.gradient = grad
-        if hessian:
-            h7 = np.zeros((len(edges), 7, 7))
-            idx = np.r_[0, 1, 2, 4, 5, 6]
-            h7[:, idx[:, None], idx[None, :]] = h_edge
-            out.hessian = self._assembler.assemble([h7, h_b + h_t])
-        return out
+        parts = {"bending": float(e_b.sum()), "twisting": float(e_t.sum())}
+        return parts, (g_b + g_t if gradient else None), (h_b + h_t if hessian else None)
 
     def _bend_twist_fused(self, geom: StencilGeometry, tau: np.ndarray):
         """Bending (Eq. 6b) and twisting (Eq. 6c) with one mapping of their Hessians to 11x11.

@@ -9,6 +9,8 @@ import os
 import tempfile
 from pathlib import Path
 
+import numpy as np
+
 from .observables import EXTRA_COLUMNS, PATH_COLUMNS
 
 
@@ -31,16 +33,17 @@ def atomic_write_text(path: Path, text: str) -> None:
 
 
 def _format(value):
-    if isinstance(value, bool):
+    if isinstance(value, (bool, np.bool_)):
         return "1" if value else "0"
     if isinstance(value, float):
         return "" if math.isnan(value) else repr(value)
     return value
 
 
-def write_path_csv(path: Path, rows: list[dict], leading: tuple[str, ...] = ()) -> None:
-    """path.csv (and branches.csv, with leading=("branch",)): the contract columns, then the extras."""
-    columns = list(leading) + list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if rows and c in rows[0]]
+def write_path_csv(path: Path, rows: list[dict], leading: tuple[str, ...] = (), trailing: tuple[str, ...] = ()) -> None:
+    """path.csv: the contract columns, then the extras present, then a model's own `trailing` ones
+    (branches.csv: leading=("branch",))."""
+    columns = list(leading) + list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if rows and c in rows[0]] + list(trailing)
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(columns)

@@ -7,42 +7,21 @@ displacement and rotations per recorded step) go to DIR/fields.xdmf for ParaView
 """
 from __future__ import annotations
 
-import csv
-import io
 import platform
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ddg.geometry.strip import InputError, LoadingProtocol, Strip
-from ddg.io import atomic_write_text, write_centerline_csv, write_summary_json
-from ddg.observables import EXTRA_COLUMNS, PATH_COLUMNS, resolved_up_to
+from ddg.api import SimulationResult
+from ddg.io import write_centerline_csv, write_path_csv, write_summary_json
+from ddg.observables import resolved_up_to
 
 FEM_COLUMNS = ("negative_eigenvalues", "half_turn_defect_over_L", "point_reflection_defect_over_L", "wall_time_s",
                "xdmf_time")
 DEFAULT_RESOLUTION = 60
 CENTERLINE_STATIONS = 101
-
-
-def _fmt(value):
-    if isinstance(value, (bool, np.bool_)):
-        return "1" if value else "0"
-    if isinstance(value, float):
-        return "" if not np.isfinite(value) else repr(value)
-    return value
-
-
-def write_fem_path_csv(path: Path, rows: list[dict]) -> None:
-    """path.csv: the contract columns, the contract's extra columns, then FEM_COLUMNS (atomic)."""
-    columns = list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if rows and c in rows[0]] + list(FEM_COLUMNS)
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(columns)
-    for row in rows:
-        writer.writerow([_fmt(row.get(c, "")) for c in columns])
-    atomic_write_text(Path(path), buf.getvalue())
 
 
 def versions() -> dict:
@@ -63,23 +42,13 @@ def versions() -> dict:
             "slepc4py": slepc4py.__version__, "gmsh": gmsh.__version__}
 
 
-@dataclass
-class FemResult:
-    rows: list[dict]
-    summary: dict
-    centerlines: list = field(default_factory=list)
-
-    @property
-    def converged(self) -> bool:
-        return bool(self.summary["converged"])
-
-    def column(self, name: str, stage: str | None = None) -> np.ndarray:
-        rows = self.rows if stage is None else [r for r in self.rows if r["stage"] == stage]
-        return np.array([r[name] for r in rows])
+class FemResult(SimulationResult):
+    """The FEM run's rows, summary and centerlines (in units of L), written like the DDG models'
+    results, with the FEM's own columns (FEM_COLUMNS) after the contract ones."""
 
     def write(self, out) -> None:
         out = Path(out)
-        write_fem_path_csv(out / "path.csv", self.rows)
+        write_path_csv(out / "path.csv", self.rows, trailing=FEM_COLUMNS)
         if self.centerlines:
             length = float(self.summary["scene"]["length"])
             write_centerline_csv(out / "centerline.csv", self.rows, [c * length for c in self.centerlines], length)
@@ -268,7 +237,7 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
         summary["wall_time_per_step_s"] = float(np.mean(step_times)) if step_times else None
         summary["recorded_steps"] = len(rows)
         summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
-        result = FemResult(rows, summary, centerlines)
+        result = FemResult(rows, summary, centerlines=centerlines)
         if out is not None:
             result.write(out)
     return result

@@ -82,8 +82,11 @@ def _base_summary(strip, protocol, resolution, model) -> dict:
 
 def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_RESOLUTION, out=None,
              options=None, across: int | None = None, fields: bool = True, progress: bool = False,
-             newton_options=None) -> FemResult:
+             newton_options=None, material: str = "isotropic") -> FemResult:
     """Run the two-stage protocol on the Naghdi shell with `resolution` elements along L.
+
+    material: "isotropic" (the strip's Poisson ratio; the paper's shell) or "dep" (the DDG
+    plate's continuum limit, fem_reference.shell.ShellParameters).
 
     Returns the rows (path.csv) and summary; writes them to `out` (also when the run stops
     early: converged = False, message says where)."""
@@ -97,18 +100,26 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
         raise InputError("simulate needs a ddg Strip and a ddg LoadingProtocol")
     if not isinstance(resolution, int) or isinstance(resolution, bool) or resolution < 4:
         raise InputError(f"resolution = {resolution!r} must be an integer >= 4 (elements along L)")
+    from .shell import MATERIALS
+
+    if material not in MATERIALS:
+        raise InputError(f"material = {material!r} is not one of {MATERIALS}")
+    if material == "dep" and strip.poisson_ratio != 0.0:
+        raise InputError(f"poisson_ratio = {strip.poisson_ratio!r} with material 'dep' (its Poisson ratios are fixed); "
+                         "use poisson_ratio = 0")
     shear_ratio = protocol.resolved_shear_ratio(strip)
     options = options or ContinuationOptions()
     t_build = time.perf_counter()
     L = strip.length
     spec = MeshSpec.from_resolution(resolution, strip.width_ratio, across)
-    params = ShellParameters(strip.thickness / L, strip.width_ratio, strip.poisson_ratio)
+    params = ShellParameters(strip.thickness / L, strip.width_ratio, strip.poisson_ratio, material)
     model = NaghdiStrip(spec, params)
     solver = Solver(model, newton_options)
     stepper = Stepper(model, solver, options)
     energy_unit = strip.plate_bending_stiffness  # E b^3 / 12, J per unit of the scaled energy
     observer = Observer(model, solver, energy_unit, options.eigenvalues)
     summary = _base_summary(strip, protocol, resolution, model)
+    summary["material"] = material
     summary["build_wall_time_s"] = time.perf_counter() - t_build
     dL = protocol.compression_ratio
     dW_end = protocol.shear_sign * shear_ratio

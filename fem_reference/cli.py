@@ -45,7 +45,7 @@ def cmd_simulate(args) -> int:
     options = ContinuationOptions(perturbation=args.perturbation, branch_switching=not args.no_branch_switching,
                                   thresholds=not args.no_thresholds)
     result = simulate(strip, protocol, args.resolution, out=args.out, options=options, across=args.across,
-                      fields=not args.no_fields, progress=not args.quiet)
+                      fields=not args.no_fields, progress=not args.quiet, material=args.material)
     s = result.summary
     if not args.quiet:
         keys = ("H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
@@ -78,6 +78,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--across", type=int, default=None, help="elements across W (default: near-isotropic)")
     p.add_argument("--perturbation", type=float, default=1e-3, help="branch-switch start amplitude / L")
     p.add_argument("--no-branch-switching", action="store_true")
+    p.add_argument("--material", choices=("isotropic", "dep"), default="isotropic",
+                   help="isotropic (the strip's Poisson ratio, default) or dep: the DDG plate's continuum limit "
+                        "(nu = 1/3 membrane, nu_b = -1/3 bending, D = E b^3/12)")
     p.add_argument("--no-thresholds", action="store_true")
     p.add_argument("--no-fields", action="store_true", help="skip fields.xdmf")
     p.add_argument("--out", default=None)

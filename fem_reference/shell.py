@@ -26,6 +26,15 @@ written here for a flat reference configuration and dolfinx 0.5.2):
 
   Pi = int (psi_b + psi_m + psi_s) dA. For nu = 0 the bending part is D/2 |kappa|^2 with
   D = E b^3/12, so a narrow strip bends with EI2 = E W b^3/12 like the rod (paper Eq. 4).
+* Material "dep" (ShellParameters(material="dep")): the continuum limit of the DDG plate
+  (ddg.models.plate; its hinge and spring energies, Eqs. 11a-b, have no Poisson ratio of their
+  own): membrane and shear with nu = 1/3, bending with D = E b^3/12 and nu_b = -1/3,
+
+      psi_b = D/2 (nu_b tr(kappa)^2 + (1 - nu_b) kappa:kappa)
+
+  (Seung-Nelson: bending modulus D, Gaussian modulus -4/3 D). A narrow strip then bends with
+  8/9 EI2 and twists with GJ = 8/3 D W, as the DEP does; this is for separating the DEP's
+  discretisation error from its modelling difference to the nu = 0 shell of the paper.
 * Discretisation: u in [P2 + B3]^3 (quadratic Lagrange enriched by the cubic bubble), theta in
   [P2]^2 on triangles. Locking (shear and membrane) is treated by partial selective reduced
   integration (PSRI, Arnold & Brezzi 1997): with alpha = b^2/h^2 per cell (h the cell diameter)
@@ -44,6 +53,7 @@ written here for a flat reference configuration and dolfinx 0.5.2):
 """
 from __future__ import annotations
 
+import contextlib
 import logging
 from dataclasses import dataclass
 
@@ -52,6 +62,19 @@ import numpy as np
 logging.getLogger("FFCx").setLevel(logging.WARNING)
 logging.getLogger("UFL").setLevel(logging.WARNING)
 logging.getLogger("root").setLevel(logging.WARNING)
+
+
+@contextlib.contextmanager
+def quiet_form_compiler():
+    """Silence INFO records while forms are JIT-compiled: the C build (setuptools' distutils
+    logging) configures the root logger at INFO on a form's first compilation, whatever its
+    level was set to before."""
+    previous = logging.root.manager.disable
+    logging.disable(logging.INFO)
+    try:
+        yield
+    finally:
+        logging.disable(previous)
 
 import dolfinx  # noqa: E402
 import dolfinx.fem.petsc  # noqa: E402,F401
@@ -73,6 +96,10 @@ EIGEN_NORMALISATION = ("lowest eigenvalue of the constrained tangent K v = lambd
                        "M = (1/W) int u.v dA over the displacement (rotations massless), times L^4/EI2")
 
 
+#: Materials of ShellParameters, and the DDG plate's effective Poisson ratios (material "dep").
+MATERIALS = ("isotropic", "dep")
+DEP_MEMBRANE_POISSON, DEP_BENDING_POISSON = 1.0 / 3.0, -1.0 / 3.0
+
 #: Below this r^2 sinc(r) and cos(r) are evaluated by their Taylor series in r^2 (no sqrt at 0).
 SMALL_ROTATION2 = 1e-6
 
@@ -90,11 +117,30 @@ def director(theta):
 
 @dataclass(frozen=True)
 class ShellParameters:
-    """Nondimensional shell data: thickness t = b/L, width w = W/L, Poisson ratio nu."""
+    """Nondimensional shell data: thickness t = b/L, width w = W/L, Poisson ratio nu, and the
+    material: "isotropic" (plane stress, nu everywhere) or "dep" (the DDG plate's continuum
+    limit: nu = 1/3 in membrane and shear, D = E t^3/12 and nu_b = -1/3 in bending; nu unused)."""
 
     thickness: float
     width: float
     poisson_ratio: float = 0.0
+    material: str = "isotropic"
+
+    def __post_init__(self):
+        if self.material not in MATERIALS:
+            raise ValueError(f"material = {self.material!r} is not one of {MATERIALS}")
+
+    @property
+    def membrane_poisson_ratio(self) -> float:
+        return DEP_MEMBRANE_POISSON if self.material == "dep" else self.poisson_ratio
+
+    def bending_moduli(self) -> tuple[float, float]:
+        """(lambda_b, 2 mu_b) of psi_b = t^3/24 (lambda_b tr(kappa)^2 + 2 mu_b kappa:kappa)."""
+        E = self.young_modulus
+        if self.material == "dep":
+            return E * DEP_BENDING_POISSON, E * (1.0 - DEP_BENDING_POISSON)
+        nu = self.poisson_ratio
+        return E * nu / (1.0 - nu**2), E / (1.0 + nu)
 
     @property
     def young_modulus(self) -> float:
@@ -119,17 +165,19 @@ class NaghdiStrip:
         self.q = fem.Function(self.V)
         self.n_dof = self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs
 
-        self._build_forms()
-        self._build_clamps()
-        self._build_observation_spaces()
+        with quiet_form_compiler():
+            self._build_forms()
+            self._build_clamps()
+            self._build_observation_spaces()
 
     # --- energy ----------------------------------------------------------------------
     def _build_forms(self):
         mesh, p = self.mesh, self.params
-        t, nu = p.thickness, p.poisson_ratio
+        t, nu = p.thickness, p.membrane_poisson_ratio
         E = p.young_modulus
         mu = E / (2.0 * (1.0 + nu))
         lam = E * nu / (1.0 - nu**2)
+        lam_b, two_mu_b = p.bending_moduli()
         u, theta = ufl.split(self.q)
         x = ufl.SpatialCoordinate(mesh)
         phi0 = ufl.as_vector([x[0], x[1], 0.0])
@@ -143,7 +191,7 @@ class NaghdiStrip:
             return lam * ufl.tr(e) ** 2 + 2.0 * mu * ufl.inner(e, e)
 
         psi_m = 0.5 * t * quad(eps)
-        psi_b = 0.5 * t**3 / 12.0 * quad(kappa)
+        psi_b = t**3 / 24.0 * (lam_b * ufl.tr(kappa) ** 2 + two_mu_b * ufl.inner(kappa, kappa))
         psi_s = 0.5 * t * SHEAR_FACTOR * mu * ufl.inner(gamma, gamma)
         dx_f = ufl.Measure("dx", domain=mesh, metadata={"quadrature_degree": FULL_DEGREE})
         dx_r = ufl.Measure("dx", domain=mesh, metadata={"quadrature_degree": REDUCED_DEGREE})
@@ -343,9 +391,10 @@ class NaghdiStrip:
         """L2 projection of a function onto `space` (MUMPS LU)."""
         w, v = ufl.TrialFunction(space), ufl.TestFunction(space)
         dx = ufl.dx(domain=self.mesh, metadata={"quadrature_degree": 6})
-        problem = fem.petsc.LinearProblem(ufl.inner(w, v) * dx, ufl.inner(source, v) * dx,
-                                          petsc_options={"ksp_type": "preonly", "pc_type": "lu",
-                                                         "pc_factor_mat_solver_type": "mumps"})
+        with quiet_form_compiler():
+            problem = fem.petsc.LinearProblem(ufl.inner(w, v) * dx, ufl.inner(source, v) * dx,
+                                              petsc_options={"ksp_type": "preonly", "pc_type": "lu",
+                                                             "pc_factor_mat_solver_type": "mumps"})
         return problem.solve()
 
 

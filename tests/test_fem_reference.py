@@ -148,6 +148,42 @@ def test_inertia_counts_negative_eigenvalues_and_branch_switch_is_real(compresse
     assert abs(heights[0] - model.positions()[model.centre_node, 2]) < 1e-8
 
 
+def _bending_energy(material: str, rotation_field) -> float:
+    """Bending energy (total - membrane - shear) of a small linear rotation field, u = 0."""
+    from dolfinx import fem
+
+    from fem_reference.mesh import MeshSpec
+    from fem_reference.shell import NaghdiStrip, ShellParameters
+
+    model = NaghdiStrip(MeshSpec.from_resolution(8, 1 / 6, None), ShellParameters(1e-3, 1 / 6, 0.0, material))
+    model.q.x.array[:] = 0.0
+    model.q.sub(1).interpolate(rotation_field)
+    model.q.x.scatter_forward()
+    total, membrane, shear = (model.mesh.comm.allreduce(fem.assemble_scalar(f)) for f in
+                              (model.energy_form, model.membrane_energy_form, model.shear_energy_form))
+    return total - membrane - shear
+
+
+def test_dep_material_twists_four_thirds_stiffer_and_bends_alike():
+    """Material "dep" (the DDG plate's continuum limit, nu_b = -1/3, D = E b^3/12): a uniform twist
+    kappa_xy costs (1 - nu_b) = 4/3 of the nu = 0 shell, a cylindrical bend kappa_xx the same;
+    both equal D/2 (nu_b tr^2 + (1 - nu_b) kappa:kappa) times the area (units D = 1, L = 1)."""
+    tau, area = 1e-4, 1 / 6
+
+    def twist(x):  # director d_y = tau x: kappa_xy = -tau/2
+        return np.vstack([-tau * x[0], 0.0 * x[0]])
+
+    def bend(x):  # director d_x = tau x: kappa_xx = -tau
+        return np.vstack([0.0 * x[0], tau * x[0]])
+
+    twist_iso, twist_dep = _bending_energy("isotropic", twist), _bending_energy("dep", twist)
+    bend_iso, bend_dep = _bending_energy("isotropic", bend), _bending_energy("dep", bend)
+    assert twist_iso == pytest.approx(0.5 * 2 * (tau / 2) ** 2 * area, rel=1e-6)
+    assert twist_dep == pytest.approx(4 / 3 * twist_iso, rel=1e-6)
+    assert bend_iso == pytest.approx(0.5 * tau**2 * area, rel=1e-6)
+    assert bend_dep == pytest.approx(bend_iso, rel=1e-6)
+
+
 def test_bad_input_exit_code_2(capsys):
     from fem_reference.cli import main
 

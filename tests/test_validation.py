@@ -83,6 +83,18 @@ def test_a_change_of_the_code_changes_the_cache_key():
     assert spec.key("version-a") == R.RunSpec("rod", 0.05, 0.5, 100).key("version-a")
 
 
+def test_frames_change_the_cache_key_only_where_asked():
+    """Runs without frames keep the key they had before RunSpec.frames existed (cached runs stay valid)."""
+    import hashlib
+    from dataclasses import asdict
+
+    spec = R.RunSpec("plate", 0.05, 0.5, 2000)
+    fields = {k: v for k, v in asdict(spec).items() if k != "frames"}
+    before = hashlib.sha256(json.dumps({"spec": fields, "code": "c"}, sort_keys=True).encode()).hexdigest()[:16]
+    assert spec.key("c") == before
+    assert R.RunSpec("plate", 0.05, 0.5, 2000, frames=True).key("c") != before
+
+
 # ---------------------------------------------------------------------------- claims
 @pytest.fixture(scope="module")
 def narrow_rod():
@@ -144,3 +156,37 @@ def test_claim_plate_and_fem_agree_on_dW1(plate_sixth):
                    "0.443 vs 0.434; the FEM itself moves by 0.021 L between 60 and 90 elements there")
 def test_claim_plate_and_fem_agree_on_the_H_mid_curve(plate_sixth):
     holds("plate_vs_fem_curve", C.curve_difference_away_from_thresholds(plate_sixth, _gold_sixth()))
+
+
+def test_snapshots_show_the_plate_states_from_its_frames(tmp_path):
+    """3D snapshots (paper Fig. 1) come from the frames the plate run kept: one panel per phase
+    the run passes (a coarse W/L = 1/6 plate passes U and US), the CSV holds the frame's nodes."""
+    pytest.importorskip("meshio", reason="the plate frames are VTU files read with meshio (python3-meshio)")
+    import csv
+
+    import numpy as np
+
+    from validation import report
+    from validation.studies import Profile
+
+    strip = ddg.Strip.from_ratios(1 / 6, 1 / 2)
+    protocol = ddg.LoadingProtocol(1 / 2, compression_steps=20, shear_steps=40)
+    ddg.simulate(strip, protocol, model="plate", resolution=300, branches=False, frames=True, out=tmp_path / "run")
+    spec = R.RunSpec("plate", 1 / 6, 1 / 2, 300, frames=True)
+    run = R.load(tmp_path / "run", spec)
+    states = report.snapshot_states(run)
+    phases = [phase.rstrip("+-") for phase, _, _ in states]
+    assert phases[:2] == ["U", "US"]
+    dw1 = run.summary["dW1_over_L"]
+    assert states[0][1] < dw1 < states[1][1]
+    profile = Profile("test", [], {"plate": 300}, [], [], (), {}, {})
+    note = report.figure_snapshots(report.Figures(tmp_path / "out"), {spec: run}, profile)
+    assert note.startswith(f"{len(states)} shapes")
+    for ext in ("png", "pdf", "csv"):
+        assert (tmp_path / "out" / "figures" / f"snapshots_3d.{ext}").stat().st_size > 0
+    with open(tmp_path / "out" / "figures" / "snapshots_3d.csv") as f:
+        rows = [r for r in csv.DictReader(f) if r["phase"] == states[0][0]]
+    import meshio
+
+    nodes = meshio.read(states[0][2]).points / strip.length
+    assert np.allclose([[float(r[k]) for k in ("x_over_L", "y_over_L", "z_over_L")] for r in rows], nodes)

@@ -157,6 +157,95 @@ def figure_shear_curves(fig_set: Figures, results, profile, golds) -> None:
                      "dW2 of each model (from stability); red triangles: the paper's quoted thresholds.")
 
 
+def _frame_index(frames_dir: Path) -> list[dict]:
+    """The frames.pvd collection of a run: [{step, file, dW_over_L, stage}], or [] if absent."""
+    import xml.etree.ElementTree as ET
+
+    pvd = frames_dir / "frames.pvd"
+    if not pvd.exists():
+        return []
+    return [{"step": int(d.get("timestep")), "file": frames_dir / d.get("file"), "stage": d.get("stage"),
+             "dW_over_L": float(d.get("dW_over_L"))} for d in ET.parse(pvd).getroot().iter("DataSet")]
+
+
+def snapshot_states(run) -> list[tuple[str, float, Path]]:
+    """(phase, dW/L, frame file) of a U, a US and an S state of a plate run: the recorded shear
+    state nearest to dW1/2 on U, to (dW1 + dW2)/2 on US (dW2 -> dW_end if S is never reached) and to
+    (dW2 + dW_end)/2 on S."""
+    frames = [f for f in _frame_index(run.directory / "frames") if f["stage"] == "shear"]
+    if not frames:
+        return []
+    s = run.summary
+    shear = [r for r in run.rows if r["stage"] == "shear"]
+    dw_end = max(float(r["dW_over_L"]) for r in shear)
+    dw1, dw2 = s.get("dW1_over_L"), s.get("dW2_over_L")
+    targets = {"U": 0.5 * dw1 if dw1 else 0.5 * dw_end,
+               "US": 0.5 * (dw1 + (dw2 or dw_end)) if dw1 else None,
+               "S": 0.5 * (dw2 + dw_end) if dw2 else None}
+    out = []
+    for phase, target in targets.items():
+        if target is None:
+            continue
+        rows = [r for r in shear if str(r["phase"]).rstrip("+-") == phase]
+        if not rows:
+            continue
+        row = min(rows, key=lambda r: abs(float(r["dW_over_L"]) - target))
+        frame = min(frames, key=lambda f: abs(f["dW_over_L"] - float(row["dW_over_L"])))
+        if abs(frame["dW_over_L"] - float(row["dW_over_L"])) < 1e-9:
+            out.append((str(row["phase"]), float(row["dW_over_L"]), frame["file"]))
+    return out
+
+
+def figure_snapshots(fig_set: Figures, results, profile) -> str:
+    """3D shapes of U, US and S plates, narrow and wide (paper Fig. 1), from the plate runs'
+    frames (matplotlib 3D; pyvista is not needed). Returns a note for the report."""
+    import matplotlib.pyplot as plt
+
+    from .studies import SNAPSHOT_SCENES
+
+    try:
+        import meshio
+    except ImportError:
+        return "Skipped: reading the plate frames needs meshio (Debian python3-meshio, scripts/setup.sh)."
+    panels = []
+    for compression, width in SNAPSHOT_SCENES:
+        run = _get(results, "plate", compression, width, profile.models.get("plate"))
+        if run is not None:
+            panels += [(compression, width, *state) for state in snapshot_states(run)]
+    if not panels:
+        return "Skipped: no plate run of this profile kept its frames (the profile runs no plate on the snapshot scenes)."
+    widths = sorted({p[1] for p in panels})
+    cols = max(sum(1 for p in panels if p[1] == w) for w in widths)
+    fig = plt.figure(figsize=(4.0 * cols, 3.0 * len(widths)))
+    rows = []
+    for i, width in enumerate(widths):
+        for j, (compression, _, phase, dw, path) in enumerate([p for p in panels if p[1] == width]):
+            mesh = meshio.read(path)
+            L = float(_get(results, "plate", compression, width, profile.models.get("plate")).summary["scene"]["length"])
+            xyz = mesh.points / L
+            triangles = mesh.cells_dict["triangle"]
+            ax = fig.add_subplot(len(widths), cols, i * cols + j + 1, projection="3d")
+            ax.plot_trisurf(xyz[:, 0], xyz[:, 1], xyz[:, 2], triangles=triangles, cmap="viridis", linewidth=0.1,
+                            edgecolor="0.3", antialiased=True)
+            extent = np.ptp(xyz, axis=0)
+            ax.set_box_aspect(np.maximum(extent, 0.05))
+            ax.view_init(elev=25, azim=-60)
+            ax.set_title(f"W/L = {_fraction(width)}: {phase}, dW/L = {dw:.3f}", fontsize=9)
+            ax.set_xlabel("x/L", fontsize=7)
+            ax.set_ylabel("y/L", fontsize=7)
+            ax.set_zlabel("z/L", fontsize=7)
+            ax.tick_params(labelsize=6)
+            rows += [[compression, width, phase, dw, k, *map(float, p)] for k, p in enumerate(xyz)]
+    fig.tight_layout()
+    fig_set.save("snapshots_3d", fig, ["compression_ratio", "width_ratio", "phase", "dW_over_L", "node",
+                                       "x_over_L", "y_over_L", "z_over_L"], rows,
+                 "Deformed plates (paper Fig. 1): U, US and S states of a narrow and a wide strip at dL/L = 1/2, "
+                 "from the plate runs' frames (U at dW1/2, US halfway between dW1 and dW2, S halfway from dW2 to "
+                 "the end of the shear).")
+    return (f"{len(panels)} shapes from the plate runs' frames (matplotlib 3D; the frames open in ParaView: "
+            "cache/<run>/frames/frames.pvd).")
+
+
 def threshold_table(results, profile, golds) -> list[dict]:
     table = []
     widths = sorted({w for _, w in profile.shear_curves} | set(profile.phase_widths))
@@ -515,6 +604,7 @@ def build_report(profile_name: str, out: Path, jobs: int = 1, progress: bool = T
     smap = stability_map(results, golds, table)
     figure_stability_map(figs, smap)
     claims = evaluate_claims(results, profile, golds)
+    snapshot_note = figure_snapshots(figs, results, profile)
 
     threshold_columns = ["model", "compression_ratio", "width_ratio", "dW1_over_L", "paper_dW1", "dW1_rel_diff_vs_paper",
                          "dW2_over_L", "paper_dW2", "dW2_rel_diff_vs_paper", "dW2_S_stable_over_L",
@@ -566,9 +656,7 @@ def build_report(profile_name: str, out: Path, jobs: int = 1, progress: bool = T
         sections.append(f"- nu = {nu:g} vs nu = 0: max |H_mid difference| = {v['max_H_difference_over_L']:.3g} L, "
                         f"dW1 difference = {v['dW1_difference'] if v['dW1_difference'] is None else round(v['dW1_difference'], 4)}")
     sections += ["", "## Stability map", "", _md_table(smap, [c for c in smap_columns if c != "message"]), "",
-                 "## 3D snapshots", "",
-                 "Skipped: pyvista is not installed (the U, US+ and S+ shapes can be opened in ParaView from "
-                 "`python -m ddg simulate --model plate --frames`).", "", "## Figures", ""]
+                 "## 3D snapshots", "", snapshot_note, "", "## Figures", ""]
     for item in figs.items:
         sections += [f"![{item['name']}](figures/{item['name']}.png)", "", f"*{item['caption']}* "
                      f"([PDF](figures/{item['name']}.pdf), [data](figures/{item['name']}.csv))", ""]

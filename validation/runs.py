@@ -36,6 +36,7 @@ class RunSpec:
     slenderness: float | None = None
     thresholds: bool = True
     branches: bool = False
+    frames: bool = False           # plate shapes per step (VTU) for the 3D snapshots
 
     @property
     def label(self) -> str:
@@ -44,7 +45,10 @@ class RunSpec:
         return f"{self.model} W/L={self.width_ratio:.4g} dL/L={self.compression_ratio:.4g}{res}{nu}"
 
     def key(self, code: str) -> str:
-        text = json.dumps({"spec": asdict(self), "code": code}, sort_keys=True)
+        spec = asdict(self)
+        if not spec["frames"]:  # added later: runs without frames keep their cache keys
+            del spec["frames"]
+        text = json.dumps({"spec": spec, "code": code}, sort_keys=True)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -111,7 +115,7 @@ def execute_one(spec: RunSpec, directory: str) -> dict:
             run_ribbon(strip, protocol, "direct", None, spec.resolution, out=directory, thresholds=spec.thresholds)
         else:
             ddg.simulate(strip, protocol, model=spec.model, resolution=spec.resolution, out=directory,
-                         thresholds=spec.thresholds, branches=spec.branches)
+                         thresholds=spec.thresholds, branches=spec.branches, frames=spec.frames)
         error = None
     except Exception as exc:  # a failed run is reported, not fatal to the report
         error = f"{type(exc).__name__}: {exc}"

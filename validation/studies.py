@@ -11,6 +11,8 @@ WIDTHS_GOLD = (1 / 20, 1 / 12, 1 / 6, 1 / 3, 1 / 2)  # FEM gold scenes
 COMPRESSIONS = (1 / 2, 1 / 4)
 #: Fig. 8: L/W from 2 to 20
 WIDTHS_PHASE_DIAGRAM = (1 / 20, 1 / 16, 1 / 12, 1 / 10, 1 / 8, 1 / 6, 1 / 5, 1 / 4, 1 / 3, 1 / 2.5, 1 / 2)
+#: (dL/L, W/L) of the 3D snapshots (paper Fig. 1): a narrow and a wide plate; their plate runs keep frames
+SNAPSHOT_SCENES = ((1 / 2, 1 / 20), (1 / 2, 1 / 6))
 SPEED_SCENE = (1 / 2, 1 / 6)  # (dL/L, W/L) of the speed-accuracy chart (the FEM gold scene of the cross-model test)
 
 
@@ -81,6 +83,11 @@ PROFILES = {"quick": quick, "full": full, "smoke": smoke}
 
 
 def shear_spec(model: str, compression: float, width: float, resolution, profile: Profile, **kw) -> RunSpec:
+    """The run of one shear curve; the plate's runs on SNAPSHOT_SCENES at the profile's resolution
+    keep their frames (one spec, shared by every study that needs that run)."""
+    if (model == "plate" and (compression, width) in SNAPSHOT_SCENES and resolution == profile.models.get("plate")
+            and not kw.get("poisson_ratio")):
+        kw.setdefault("frames", True)
     return RunSpec(model, width, compression, resolution, None, 40, profile.shear_steps, **kw)
 
 

@@ -63,6 +63,12 @@ def cmd_convergence(args) -> int:
     return run_convergence(args)
 
 
+def cmd_convergence_table(args) -> int:
+    from .convergence import table_from_runs
+
+    return table_from_runs(args)
+
+
 def cmd_gold(args) -> int:
     from .gold import run_gold
 
@@ -92,6 +98,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_convergence)
+    p = sub.add_parser("convergence-table", help="the convergence table of finished runs (simulate/gold folders)")
+    p.add_argument("--runs", nargs="+", required=True, help="output folders of one scene on 2 or more meshes")
+    p.add_argument("--out", required=True)
+    p.set_defaults(func=cmd_convergence_table)
     p = sub.add_parser("gold", help="reference runs of the paper's scenes into a data folder")
     p.add_argument("--out", required=True)
     p.add_argument("--only", nargs="*", default=None,

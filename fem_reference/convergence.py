@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 from pathlib import Path
 
@@ -70,12 +71,54 @@ def run_convergence(args) -> int:
     return 0 if all(r.converged for r in runs) else 3
 
 
+class StoredRun:
+    """A finished `simulate` output folder (path.csv, summary.json) read back for the tables."""
+
+    def __init__(self, directory):
+        from ddg.io import read_path_csv
+
+        directory = Path(directory)
+        self.summary = json.loads((directory / "summary.json").read_text())
+        self.rows = [{k: (v if k in ("stage", "phase") else (float(v) if v != "" else float("nan")))
+                      for k, v in r.items()} for r in read_path_csv(directory / "path.csv")]
+        self.converged = bool(self.summary.get("converged"))
+
+
+def table_from_runs(args) -> int:
+    """`convergence-table --runs DIR ...`: the convergence table of finished runs of one scene."""
+    from ddg.geometry.strip import InputError, LoadingProtocol, Strip
+
+    runs = [StoredRun(d) for d in args.runs]
+    scenes = {(r.summary["scene"]["width_ratio"], r.summary["scene"]["compression_ratio"],
+               r.summary["scene"]["slenderness"]) for r in runs}
+    if len(scenes) != 1:
+        raise InputError(f"the runs are of different scenes {sorted(scenes)}; give runs of one scene")
+    runs.sort(key=lambda r: r.summary["scene"]["resolution"])
+    resolutions = [r.summary["scene"]["resolution"] for r in runs]
+    if len(set(resolutions)) != len(resolutions):
+        raise InputError(f"resolutions {resolutions} repeat; give one run per mesh")
+    width, compression, slenderness = scenes.pop()
+    strip = Strip.from_ratios(width, compression, slenderness)
+    rows, table = summarise(runs, resolutions)
+    write_outputs(Path(args.out), rows, table, runs, resolutions, strip, LoadingProtocol(compression))
+    return 0
+
+
 def summarise(runs, resolutions):
-    """Per-mesh H_mid(dW) on the common recorded grid, extrapolated values and estimated errors."""
+    """Per-mesh H_mid(dW) on the coarsest run's recorded dW grid (each run interpolated onto it,
+    up to the smallest dW all runs reached), extrapolated values and estimated errors."""
     shear = [[r for r in run.rows if r["stage"] == "shear"] for run in runs]
-    n_common = min(len(s) for s in shear)
-    dw = np.array([row["dW_over_L"] for row in shear[0][:n_common]])
-    H = np.array([[row["H_mid_over_L"] for row in s[:n_common]] for s in shear])
+    curves = []
+    for s in shear:
+        dw_i = np.array([row["dW_over_L"] for row in s])
+        order = np.argsort(dw_i)
+        curves.append((dw_i[order], np.array([row["H_mid_over_L"] for row in s])[order]))
+    reach = min(c[0][-1] for c in curves)
+    grid = [row for row in shear[0] if row["dW_over_L"] <= reach + 1e-12]
+    n_common = len(grid)
+    dw = np.array([row["dW_over_L"] for row in grid])
+    H = np.array([np.interp(dw, *c) for c in curves])
+    phases = [[s[int(np.argmin(np.abs(np.array([r["dW_over_L"] for r in s]) - x)))]["phase"] for x in dw] for s in shear]
     compressed = np.array([[run.summary["H_mid_over_L_compressed"]] for run in runs])
     H_ext, p = extrapolate(H, resolutions) if len(runs) >= 2 else (H[-1], np.full(n_common, np.nan))
     Hc_ext, pc = extrapolate(compressed, resolutions) if len(runs) >= 2 else (compressed[-1], [np.nan])
@@ -83,11 +126,12 @@ def summarise(runs, resolutions):
     for i, run in enumerate(runs):
         for j in range(n_common):
             rows.append({"resolution": resolutions[i], "dW_over_L": dw[j], "H_mid_over_L": H[i, j],
-                         "phase": shear[i][j]["phase"], "H_extrapolated": H_ext[j], "order": p[j],
+                         "phase": phases[i][j], "H_extrapolated": H_ext[j], "order": p[j],
                          "error_estimate": abs(H[i, j] - H_ext[j])})
     dw1 = np.array([np.nan if run.summary["dW1_over_L"] is None else run.summary["dW1_over_L"] for run in runs])
     dw2 = np.array([np.nan if run.summary["dW2_over_L"] is None else run.summary["dW2_over_L"] for run in runs])
     dw1_ext, p1 = extrapolate(dw1[:, None], resolutions) if len(runs) >= 2 else (dw1[-1:], [np.nan])
+    dw2_ext, p2 = extrapolate(dw2[:, None], resolutions) if len(runs) >= 2 else (dw2[-1:], [np.nan])
     table = []
     for i, run in enumerate(runs):
         s = run.summary
@@ -101,15 +145,18 @@ def summarise(runs, resolutions):
             "dW1_over_L": dw1[i],
             "dW1_error": abs(dw1[i] - float(dw1_ext[0])),
             "dW2_over_L": dw2[i],
+            "dW2_error": abs(dw2[i] - float(dw2_ext[0])),
             "H_max_error": float(np.nanmax(np.abs(H[i] - H_ext))),
             "H_max_error_away": float(np.nanmax(np.where(_away(dw, dw1_ext[0], dw2[-1]), np.abs(H[i] - H_ext), np.nan))),
+            "dW_reached_over_L": float(curves[i][0][-1]),
             "wall_time_path_s": s["wall_time_s"],
             "wall_time_per_step_s": s["wall_time_s"] / max(steps, 1),
             "newton_iterations": s["newton_iterations"],
             "converged": s["converged"],
         })
     table.append({"resolution": "extrapolated", "H_compressed": float(Hc_ext[0]), "dW1_over_L": float(dw1_ext[0]),
-                  "order_H_compressed": float(np.asarray(pc).ravel()[0]), "order_dW1": float(np.asarray(p1).ravel()[0])})
+                  "dW2_over_L": float(dw2_ext[0]), "order_H_compressed": float(np.asarray(pc).ravel()[0]),
+                  "order_dW1": float(np.asarray(p1).ravel()[0]), "order_dW2": float(np.asarray(p2).ravel()[0])})
     return rows, table
 
 
@@ -144,17 +191,19 @@ def write_outputs(out: Path, rows, table, runs, resolutions, strip, protocol) ->
              "Richardson extrapolation from the finest meshes with the observed order (clipped to [0.5, 4]); "
              "errors are |value - extrapolated|. H errors over the common recorded dW grid; 'away' excludes "
              "dW within 0.02 L of dW1 and dW2.", "",
-             "| N along L | triangles | unknowns | H_mid/L compressed | error | dW1/L | error | dW2/L | "
-             "max H error | max H error away | s / step | s / path | Newton its |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| N along L | triangles | unknowns | H_mid/L compressed | error | dW1/L | error | dW2/L | error | "
+             "dW/L reached | max H error | max H error away | s / step | s / path | Newton its |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for t in table[:-1]:
         lines.append(f"| {t['resolution']} | {t['triangles']} | {t['n_dof']} | {f(t['H_compressed'], '{:.6f}')} | "
                      f"{f(t['H_compressed_error'], '{:.1e}')} | {f(t['dW1_over_L'], '{:.4f}')} | "
-                     f"{f(t['dW1_error'], '{:.1e}')} | {f(t['dW2_over_L'], '{:.3f}')} | {f(t['H_max_error'], '{:.1e}')} | "
+                     f"{f(t['dW1_error'], '{:.1e}')} | {f(t['dW2_over_L'], '{:.4f}')} | {f(t['dW2_error'], '{:.1e}')} | "
+                     f"{f(t['dW_reached_over_L'], '{:.3f}')} | {f(t['H_max_error'], '{:.1e}')} | "
                      f"{f(t['H_max_error_away'], '{:.1e}')} | {f(t['wall_time_per_step_s'], '{:.2f}')} | "
                      f"{f(t['wall_time_path_s'], '{:.0f}')} | {t['newton_iterations']} |")
     e = table[-1]
     lines += ["", f"Extrapolated: H_mid/L compressed = {f(e['H_compressed'], '{:.6f}')} (order "
               f"{f(e['order_H_compressed'], '{:.2f}')}), dW1/L = {f(e['dW1_over_L'], '{:.4f}')} "
-              f"(order {f(e['order_dW1'], '{:.2f}')}).", ""]
+              f"(order {f(e['order_dW1'], '{:.2f}')}), dW2/L = {f(e['dW2_over_L'], '{:.4f}')} "
+              f"(order {f(e['order_dW2'], '{:.2f}')}).", ""]
     atomic_write_text(out / "convergence.md", "\n".join(lines) + "\n")

@@ -19,9 +19,9 @@ WIDTH_RATIOS = (1 / 20, 1 / 12, 1 / 6, 1 / 3, 1 / 2)
 COMPRESSION_RATIOS = (1 / 2, 1 / 4)
 #: Elements along L for the gold runs (across W: near-isotropic, >= 10 for W/L = 1/6).
 GOLD_RESOLUTION = 60
-#: Scenes run finer: W/L = 1/6 at dL/L = 1/2 is the cross-model reference, and at 60 elements its
-#: dW2 is 0.033 L off the 90-element value (0.4664 vs 0.4336) and H_mid on US 0.021 L.
-GOLD_RESOLUTIONS = {"dL0.5_W0.1667": 90}
+#: Scenes run finer: W/L = 1/6 at dL/L = 1/2 is the cross-model reference. Its dW2/L on 60 / 90 / 120
+#: elements: 0.4664 / 0.4336 / 0.4306 (extrapolated 0.4293), dW1/L 0.2564 / 0.2614 / 0.2640 (0.2685).
+GOLD_RESOLUTIONS = {"dL0.5_W0.1667": 120}
 
 
 def scene_name(compression_ratio: float, width_ratio: float) -> str:
@@ -99,10 +99,18 @@ Regenerate all scenes (one at a time, complete ones are skipped; about 1-2 hours
 
 One scene: `--only dL0.5_W0.1667` (names dL<dL/L>_W<W/L>: dL0.5_W0.05, dL0.5_W0.08333,
 dL0.5_W0.1667, dL0.5_W0.3333, dL0.5_W0.5, dL0.25_W0.05, ...). Default mesh: 60 elements along L
-(90 for dL0.5_W0.1667, the cross-model reference), across W near-isotropic and at least 60 W/L. Each folder holds path.csv, summary.json and
-centerline.csv (the DDG output contract); `index.json` lists what exists. Mesh convergence of the
-W/L = 1/6, dL/L = 1/2 scene (60/90/120 elements along L): ../fem_convergence/dL0.5_W0.1667/convergence.md
-(at 60 elements dW1/L is about 0.012 low and H_mid on US up to 0.024 L off the extrapolated curve).
+(120 for dL0.5_W0.1667, the cross-model reference, about 22 min), across W near-isotropic and at
+least 60 W/L. Each folder holds path.csv, summary.json and centerline.csv (the DDG output
+contract); `index.json` lists what exists.
+
+Mesh convergence of the W/L = 1/6, dL/L = 1/2 scene, whole paths on 60/90/120 elements along L
+(`python -m fem_reference convergence-table --runs ../fem_fine/dL0.5_W0.1667_N60
+../fem_fine/dL0.5_W0.1667_N90 dL0.5_W0.1667 --out ../fem_convergence/dL0.5_W0.1667_full`):
+../fem_convergence/dL0.5_W0.1667_full/convergence.md. Estimated errors of the 120-element gold run
+against the Richardson extrapolation: dW1/L 0.0046 (extrapolated 0.2685), dW2/L 0.0014 (0.4293),
+H_mid/L up to 0.0036 L on the path (one point, dW/L = 0.358 on US, where the observed order is
+unreliable: 0.009 L). The other gold scenes are on 60 elements, where the same scene is off by
+0.012 in dW1/L, 0.037 in dW2/L and up to 0.024 L in H_mid/L: read them as such.
 
 ## What exists (written by the gold command)
 

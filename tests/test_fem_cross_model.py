@@ -6,6 +6,7 @@ Issue 5: H_mid(dW) within 0.01 L away from the thresholds, dW1 within 0.02 L. Re
 gold data (dolfinx not needed); runs the plate at its default mesh (about 2000 triangles)."""
 from __future__ import annotations
 
+import csv
 import json
 from pathlib import Path
 
@@ -64,3 +65,28 @@ def test_plate_and_fem_agree_on_h_mid_away_from_thresholds(fem_gold, plate_run):
     assert away.sum() > 20
     gap = np.abs(h_plate - h_fem)[away]
     assert gap.max() < 0.01, f"max |H_plate - H_fem| = {gap.max():.4f} L at dW/L = {dw[away][np.argmax(gap)]:.3f}"
+
+
+def test_gold_scene_converges_with_the_mesh(tmp_path):
+    """The stored whole paths of the cross-model scene on 60 / 90 / 120 elements (data/fem_fine,
+    data/fem_gold): dW1 and dW2 move less from each mesh to the next, and the convergence table
+    built from them (python -m fem_reference convergence-table) has finite observed orders and
+    puts the 120-element gold run within 0.005 L of the extrapolated dW1 and dW2."""
+    from types import SimpleNamespace
+
+    from fem_reference.convergence import table_from_runs
+
+    data = GOLD.parents[1]
+    runs = [data / "fem_fine" / "dL0.5_W0.1667_N60", data / "fem_fine" / "dL0.5_W0.1667_N90", GOLD]
+    if not all((d / "summary.json").exists() for d in runs):
+        pytest.skip("the stored FEM runs of the convergence table are missing")
+    assert table_from_runs(SimpleNamespace(runs=[str(d) for d in runs], out=str(tmp_path))) == 0
+    table = list(csv.DictReader(open(tmp_path / "thresholds.csv")))
+    meshes, extrapolated = table[:-1], table[-1]
+    assert [int(t["resolution"]) for t in meshes] == [60, 90, 120]
+    for key in ("dW1_over_L", "dW2_over_L"):
+        values = [float(t[key]) for t in meshes]
+        assert abs(values[2] - values[1]) < abs(values[1] - values[0]), (key, values)
+        assert abs(float(meshes[-1][key]) - float(extrapolated[key])) < 0.005, key
+    for key in ("order_dW1", "order_dW2"):
+        assert np.isfinite(float(extrapolated[key])), key

@@ -16,6 +16,8 @@ from ddg.io import read_path_csv
 
 ROOT = Path(__file__).resolve().parent.parent
 FEM_GOLD = ROOT / "data" / "fem_gold"
+FEM_FINE = ROOT / "data" / "fem_fine"   # FEM runs kept for comparison (other meshes)
+FEM_DEP = ROOT / "data" / "fem_dep"     # FEM shell with the DDG plate's material (--material dep)
 
 #: (dL/L, W/L) -> {"dW1": value, "dW2": value} as quoted in the text of the paper.
 PAPER_THRESHOLDS = {

@@ -144,19 +144,16 @@ def _gold_sixth():
     return gold
 
 
-@pytest.mark.slow
 def test_claim_plate_and_fem_agree_on_dW1(plate_sixth_fine):
     """Measured 0.2575 (plate, 5740 triangles) vs 0.2640 (FEM, 120 x 20 elements)."""
     holds("plate_vs_fem_dW1", C.threshold_difference(plate_sixth_fine, _gold_sixth()))
 
 
-@pytest.mark.slow
 def test_claim_plate_and_fem_agree_on_the_H_mid_curve(plate_sixth_fine):
     """Measured 0.0098 L at 5740 triangles (0.013 L at the default 2000)."""
     holds("plate_vs_fem_curve", C.curve_difference_away_from_thresholds(plate_sixth_fine, _gold_sixth()))
 
 
-@pytest.mark.slow
 def test_claim_plate_and_the_shell_with_its_material_agree(plate_sixth_fine):
     from validation.report import load_dep_material
 

@@ -419,7 +419,8 @@ def speed_accuracy(results, study_specs, golds) -> tuple[list[dict], str]:
     gold = golds.get(SPEED_SCENE)
     runs = [(s, results[s]) for s in study_specs if s in results]
     if gold is not None:
-        reference, ref_name = gold, "FEM gold"
+        reference = gold
+        ref_name = f"FEM gold ({gold.summary['scene']['resolution']} elements along L; FEM points: coarser shell meshes)"
     else:
         if not runs:
             return [], "none"
@@ -434,6 +435,18 @@ def speed_accuracy(results, study_specs, golds) -> tuple[list[dict], str]:
                      "curve_error": C.curve_difference_away_from_thresholds(run, reference),
                      "dW1_error": C.threshold_difference(run, reference),
                      "converged": run.summary.get("converged")})
+    if gold is not None:  # the shell itself on coarser meshes (stored runs), against its gold mesh
+        from .reference import FEM_FINE, GoldCurve
+
+        for directory in sorted(FEM_FINE.glob("dL0.5_W0.1667_N*")):
+            if not (directory / "summary.json").exists():
+                continue
+            fem = GoldCurve(directory)
+            data.append({"model": "fem", "resolution": fem.summary["scene"]["resolution"],
+                         "wall_time_s": fem.summary.get("wall_time_s"),
+                         "curve_error": C.curve_difference_away_from_thresholds(fem, reference),
+                         "dW1_error": C.threshold_difference(fem, reference),
+                         "converged": fem.summary.get("converged")})
     return data, ref_name
 
 

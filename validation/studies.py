@@ -104,9 +104,10 @@ def specs(profile: Profile) -> dict[str, list[RunSpec]]:
             out["shear"].append(shear_spec("plate", c, w, profile.models["plate"], profile))
         if "ribbon" in profile.models and (c, w) in profile.ribbon_scenes:
             out["shear"].append(shear_spec("ribbon", c, w, profile.models["ribbon"], profile))
-    for c in COMPRESSIONS:
+    for c in COMPRESSIONS:  # Fig. 8: the plate and the rod (cheap) at every width
         for w in profile.phase_widths:
             out["phase"].append(shear_spec("plate", c, w, profile.models["plate"], profile))
+            out["phase"].append(shear_spec("rod", c, w, profile.models["rod"], profile))
     conv_scene = (1 / 2, 1 / 20)
     for model, resolutions in profile.convergence.items():
         scene = conv_scene if model == "rod" else SPEED_SCENE

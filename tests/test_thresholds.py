@@ -37,6 +37,23 @@ def test_rod_thresholds_at_quarter_compression():
     assert summary["dW2_over_L"] == pytest.approx(0.37, abs=0.02)
 
 
+def test_dW1_is_found_when_the_secant_lands_on_the_critical_point():
+    """W/L = 0.2, dL/L = 1/2, M = 100 (a phase-diagram scene of the full report): lambda_min on U is
+    nearly linear in dW, so the first secant step lands on the pitchfork itself, where the Hessian
+    is singular and Newton does not converge. dW1 used to come out None there; now the search
+    steps beside the failed point. The recorded path brackets it: lambda_min 7.06 on U at
+    dW/L = 0.3501, US+ from 0.3559."""
+    strip = ddg.Strip.from_ratios(0.2, 0.5)
+    protocol = ddg.LoadingProtocol(0.5, compression_steps=40, shear_steps=120)
+    result = ddg.simulate(strip, protocol, model="rod", resolution=100, branches=False)
+    dw1 = result.summary["dW1_over_L"]
+    assert dw1 is not None
+    shear = [r for r in result.rows if r["stage"] == "shear"]
+    last_u = max(r["dW_over_L"] for r in shear if r["phase"] == "U" and r["dW_over_L"] < 0.4)
+    first_us = min(r["dW_over_L"] for r in shear if r["phase"].startswith("US"))
+    assert last_u < dw1 < first_us
+
+
 def test_thresholds_do_not_depend_on_the_size_of_the_kick(narrow_rod):
     """The push off an unstable state only selects the branch; the thresholds come from
     stability, so a 100x smaller kick gives the same dW1 (to its 1e-4 tolerance) and dW2 (1e-3)."""

@@ -65,8 +65,14 @@ def locate_sign_change(model, options, start: Snapshot, other: float, tolerance:
     while abs(b - a) > tolerance:
         guess = (a * lam_b - b * lam_a) / (lam_b - lam_a)
         guess = min(max(guess, min(a, b) + 0.01 * abs(b - a)), max(a, b) - 0.01 * abs(b - a))
-        state = _advance(model, options, start, guess, switching=False)
-        if state is None:
+        # The secant can land on the critical point itself, where the Hessian is singular and
+        # Newton may not converge: then try points between the guess and either end.
+        for trial in (guess, 0.5 * (guess + a), 0.5 * (guess + b), 0.75 * a + 0.25 * b, 0.25 * a + 0.75 * b):
+            state = _advance(model, options, start, trial, switching=False)
+            if state is not None:
+                guess = trial
+                break
+        else:
             return None
         lam = _lambda_min(model, state)
         if lam * lam_a > 0:

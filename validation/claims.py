@@ -30,6 +30,8 @@ CLAIMS = {c.key: c for c in (
           "relative error", 1e-3),
     Claim("plate_elastica", "plate (W/L = 1/6) H_mid/L after compression to dL/L = 1/2 vs the exact elastica, "
           "relative error", 2e-3),
+    Claim("ribbon_elastica", "ribbon (M = 101, W/L = 1/20) H_mid/L after compression to dL/L = 1/2 vs the exact "
+          "elastica, relative error", 1e-3),
     Claim("fem_elastica", "FEM shell (W/L = 1/6) H_mid/L after compression to dL/L = 1/2 vs the exact elastica, "
           "relative error", 5e-3),
     Claim("rod_vs_plate_narrow_U", "rod vs plate at W/L = 1/20, dL/L = 1/2: largest H_mid difference/L on the "

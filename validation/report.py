@@ -589,6 +589,8 @@ def evaluate_claims(results, profile, golds) -> list[dict]:
     dep6 = load_dep_material()
     out.append(C.evaluate("rod_elastica", C.elastica_error(rod) if rod else None))
     out.append(C.evaluate("plate_elastica", C.elastica_error(plate6) if plate6 else None))
+    ribbon = get("ribbon", 0.5, 1 / 20)
+    out.append(C.evaluate("ribbon_elastica", C.elastica_error(ribbon) if ribbon else None))
     out.append(C.evaluate("fem_elastica", C.elastica_error(gold6) if gold6 else None))
     out.append(C.evaluate("rod_vs_plate_narrow_U", C.u_branch_difference(plate20, rod) if plate20 and rod else None))
     out.append(C.evaluate("plate_vs_fem_curve", C.curve_difference_away_from_thresholds(plate6_fine, gold6)

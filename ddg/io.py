@@ -83,3 +83,38 @@ def write_centerline_csv(path: Path, rows: list[dict], centerlines: list, length
 def read_path_csv(path: Path) -> list[dict]:
     with open(path, newline="") as fh:
         return list(csv.DictReader(fh))
+
+
+#: path.csv / branches.csv columns that hold text; every other column is read as a number.
+TEXT_COLUMNS = ("stage", "phase", "branch")
+
+
+def read_numeric_rows(path: Path) -> list[dict]:
+    """A path.csv-style file with numbers as floats (empty cells nan), TEXT_COLUMNS as strings."""
+    out = []
+    for row in read_path_csv(path):
+        parsed = {}
+        for key, value in row.items():
+            if key in TEXT_COLUMNS:
+                parsed[key] = value
+            else:
+                try:
+                    parsed[key] = float(value) if value != "" else float("nan")
+                except ValueError:
+                    parsed[key] = value
+        out.append(parsed)
+    return out
+
+
+class StoredRun:
+    """A finished output folder read back: `.rows` (path.csv, numbers parsed), `.summary`
+    (summary.json), `.converged` and `.column(name, stage)`; any model writes this contract."""
+
+    def __init__(self, directory):
+        self.directory = Path(directory)
+        self.summary = json.loads((self.directory / "summary.json").read_text())
+        self.rows = read_numeric_rows(self.directory / "path.csv")
+        self.converged = bool(self.summary.get("converged"))
+
+    def column(self, name: str, stage: str | None = None) -> np.ndarray:
+        return np.array([r[name] for r in self.rows if stage is None or r["stage"] == stage])

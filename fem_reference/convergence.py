@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import math
 from pathlib import Path
 
@@ -71,22 +70,10 @@ def run_convergence(args) -> int:
     return 0 if all(r.converged for r in runs) else 3
 
 
-class StoredRun:
-    """A finished `simulate` output folder (path.csv, summary.json) read back for the tables."""
-
-    def __init__(self, directory):
-        from ddg.io import read_path_csv
-
-        directory = Path(directory)
-        self.summary = json.loads((directory / "summary.json").read_text())
-        self.rows = [{k: (v if k in ("stage", "phase") else (float(v) if v != "" else float("nan")))
-                      for k, v in r.items()} for r in read_path_csv(directory / "path.csv")]
-        self.converged = bool(self.summary.get("converged"))
-
-
 def table_from_runs(args) -> int:
     """`convergence-table --runs DIR ...`: the convergence table of finished runs of one scene."""
     from ddg.geometry.strip import InputError, LoadingProtocol, Strip
+    from ddg.io import StoredRun
 
     runs = [StoredRun(d) for d in args.runs]
     scenes = {(r.summary["scene"]["width_ratio"], r.summary["scene"]["compression_ratio"],

@@ -7,12 +7,11 @@ dL/L = 1/4: W/L = 1/20: 0.23 and 0.37; dW1 drops by 15.8, 29.1 and 65.6 % at W/L
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
-from ddg.io import read_path_csv
+from ddg.io import StoredRun
 
 ROOT = Path(__file__).resolve().parent.parent
 FEM_GOLD = ROOT / "data" / "fem_gold"
@@ -45,17 +44,8 @@ def gold_name(compression_ratio: float, width_ratio: float) -> str:
     return f"dL{compression_ratio:.4g}_W{width_ratio:.4g}"
 
 
-class GoldCurve:
-    """A FEM reference run read from data/fem_gold/<scene>/ (path.csv, summary.json)."""
-
-    def __init__(self, directory: Path):
-        self.directory = directory
-        self.summary = json.loads((directory / "summary.json").read_text())
-        self.rows = [{k: (v if k in ("stage", "phase") else (float(v) if v != "" else np.nan)) for k, v in r.items()}
-                     for r in read_path_csv(directory / "path.csv")]
-
-    def column(self, name: str, stage: str | None = None) -> np.ndarray:
-        return np.array([r[name] for r in self.rows if stage is None or r["stage"] == stage])
+#: A FEM reference run read from data/fem_gold/<scene>/ (or any output folder of the contract).
+GoldCurve = StoredRun
 
 
 def load_gold(compression_ratio: float, width_ratio: float, root: Path = FEM_GOLD) -> GoldCurve | None:

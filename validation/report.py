@@ -113,6 +113,27 @@ def figure_elastica(fig_set: Figures, results, profile, golds) -> None:
                  "Midpoint height under compression (paper Fig. 5b): models against the exact clamped elastica.")
 
 
+def _plot_shear_column(ax, results, profile, golds, compression, width, column, thresholds=False) -> list[list]:
+    """`column` against dW/L on the shear stage for every model run of the scene and the FEM gold
+    (dotted dW1 and dashed dW2 lines per model if `thresholds`); the plotted numbers as CSV rows."""
+    rows = []
+    curves = [(model, _get(results, model, compression, width, profile.models.get(model)))
+              for model in ("rod", "plate", "ribbon")] + [("fem", golds.get((compression, width)))]
+    for model, run in curves:
+        if run is None:
+            continue
+        dw, y = _shear(run, "dW_over_L"), _shear(run, column)
+        if model == "fem":
+            ax.plot(dw, y, "k.", ms=3, label="FEM")
+        else:
+            ax.plot(dw, y, "-", color=COLORS[model], label=model)
+            for key, style in (("dW1_over_L", ":"), ("dW2_over_L", "--")) if thresholds else ():
+                if run.summary.get(key) is not None:
+                    ax.axvline(run.summary[key], color=COLORS[model], ls=style, lw=0.8)
+        rows += [[model, compression, width, a, b] for a, b in zip(dw, y)]
+    return rows
+
+
 def figure_shear_curves(fig_set: Figures, results, profile, golds) -> None:
     import matplotlib.pyplot as plt
 
@@ -125,21 +146,7 @@ def figure_shear_curves(fig_set: Figures, results, profile, golds) -> None:
         fig, axes = plt.subplots(nrows, cols, figsize=(4.2 * cols, 3.3 * nrows), squeeze=False)
         rows = []
         for ax, width in zip(axes.flat, scenes):
-            for model in ("rod", "plate", "ribbon"):
-                run = _get(results, model, compression, width, profile.models.get(model))
-                if run is None:
-                    continue
-                dw, h = _shear(run, "dW_over_L"), _shear(run, "H_mid_over_L")
-                ax.plot(dw, h, "-", color=COLORS[model], label=model)
-                rows += [[model, compression, width, a, b] for a, b in zip(dw, h)]
-                for key, style in (("dW1_over_L", ":"), ("dW2_over_L", "--")):
-                    if run.summary.get(key) is not None:
-                        ax.axvline(run.summary[key], color=COLORS[model], ls=style, lw=0.8)
-            gold = golds.get((compression, width))
-            if gold is not None:
-                dw, h = gold.column("dW_over_L", "shear"), gold.column("H_mid_over_L", "shear")
-                ax.plot(dw, h, "k.", ms=3, label="FEM")
-                rows += [["fem", compression, width, a, b] for a, b in zip(dw, h)]
+            rows += _plot_shear_column(ax, results, profile, golds, compression, width, "H_mid_over_L", thresholds=True)
             for key, marker in (("dW1", "v"), ("dW2", "^")):
                 paper = paper_value(compression, width, key)
                 if paper is not None:
@@ -322,18 +329,7 @@ def figure_shear_force(fig_set: Figures, results, profile, golds) -> None:
     fig, axes = plt.subplots(1, len(scenes), figsize=(4.5 * len(scenes), 3.4), squeeze=False)
     rows = []
     for ax, (compression, width) in zip(axes.flat, scenes):
-        for model in ("rod", "plate", "ribbon"):
-            run = _get(results, model, compression, width, profile.models.get(model))
-            if run is None:
-                continue
-            dw, f = _shear(run, "dW_over_L"), _shear(run, "F_shear_norm")
-            ax.plot(dw, f, "-", color=COLORS[model], label=model)
-            rows += [[model, compression, width, a, b] for a, b in zip(dw, f)]
-        gold = golds.get((compression, width))
-        if gold is not None:
-            dw, f = gold.column("dW_over_L", "shear"), gold.column("F_shear_norm", "shear")
-            ax.plot(dw, f, "k.", ms=3, label="FEM")
-            rows += [["fem", compression, width, a, b] for a, b in zip(dw, f)]
+        rows += _plot_shear_column(ax, results, profile, golds, compression, width, "F_shear_norm")
         ax.set_yscale("symlog", linthresh=1.0)
         ax.set_title(f"W/L = {_fraction(width)}, dL/L = {_fraction(compression)}", fontsize=9)
         ax.set_xlabel("dW/L")
@@ -571,7 +567,8 @@ def material_check(results, profile, golds) -> dict | None:
            "plate_vs_fem_dep_curve": C.curve_difference_away_from_thresholds(plate, dep)}
     out["statement"] = (
         f"The plate's material is not the cause of its gap to the FEM shell at W/L = 1/6, dL/L = 1/2: the shell with "
-        f"the DEP's material (membrane nu = 1/3, bending nu_b = -1/3; 90 x 15 elements) differs from the nu = 0 shell "
+        f"the DEP's material (membrane nu = 1/3, bending nu_b = -1/3; {dep.summary['scene']['resolution']} elements "
+        f"along L) differs from the nu = 0 shell "
         f"on the same mesh by {out['fem_dep_vs_nu0_dW1']:.4f} in dW1/L and {out['fem_dep_vs_nu0_curve']:.4f} L in "
         f"H_mid, while the plate ({plate.summary['mesh']['triangles']} triangles) differs from it by "
         f"{out['plate_vs_fem_dep_dW1']:.4f} and {out['plate_vs_fem_dep_curve']:.4f} L: the rest of the gap is the "

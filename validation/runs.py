@@ -18,7 +18,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ddg.io import atomic_write_text, read_path_csv
+from ddg.io import atomic_write_text, read_numeric_rows
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -74,26 +74,10 @@ class RunResult:
                 for r in self.rows if stage is None or r["stage"] == stage]
 
 
-def _numeric(rows: list[dict]) -> list[dict]:
-    out = []
-    for row in rows:
-        parsed = {}
-        for k, v in row.items():
-            if k in ("stage", "phase", "branch"):
-                parsed[k] = v
-            else:
-                try:
-                    parsed[k] = float(v) if v != "" else float("nan")
-                except ValueError:
-                    parsed[k] = v
-        out.append(parsed)
-    return out
-
-
 def load(directory: Path, spec: RunSpec) -> RunResult:
-    rows = _numeric(read_path_csv(directory / "path.csv")) if (directory / "path.csv").exists() else []
+    rows = read_numeric_rows(directory / "path.csv") if (directory / "path.csv").exists() else []
     branches = directory / "branches.csv"
-    branch_rows = _numeric(read_path_csv(branches)) if branches.exists() else []
+    branch_rows = read_numeric_rows(branches) if branches.exists() else []
     summary = json.loads((directory / "summary.json").read_text())
     return RunResult(spec, directory, rows, summary, branch_rows)
 

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .geometry.strip import InputError
 from .observables import EXTRA_COLUMNS, PATH_COLUMNS
 
 
@@ -118,3 +119,104 @@ class StoredRun:
 
     def column(self, name: str, stage: str | None = None) -> np.ndarray:
         return np.array([r[name] for r in self.rows if stage is None or r["stage"] == stage])
+
+
+def check_output_directory(out, name: str = "out") -> Path:
+    """The output directory `out`, created if missing and proven writable, before any work.
+
+    Refused with a one-line InputError: a value that is not a path, an empty name (which would
+    write into the current directory), an existing file or device (/dev/null), a path under a
+    file, a name the file system refuses (too long), a directory that cannot be written."""
+    if out is None or isinstance(out, bool) or not isinstance(out, (str, os.PathLike)):
+        raise InputError(f"{name} = {out!r} must be a directory path (str or os.PathLike)")
+    text = os.fspath(out)
+    if isinstance(text, bytes):
+        text = os.fsdecode(text)
+    if text.strip() == "":
+        raise InputError(f"{name} = {text!r} is empty; give an output directory (e.g. out/run1)")
+    path = Path(text)
+    try:
+        if path.exists() and not path.is_dir():
+            raise InputError(f"{name} = {text!r} exists and is not a directory")
+        path.mkdir(parents=True, exist_ok=True)
+    except InputError:
+        raise
+    except OSError as exc:
+        raise InputError(f"{name} = {text!r} cannot be created: {exc.strerror or exc}") from None
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".write-test-", dir=path)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise InputError(f"{name} = {text!r} is not writable: {exc.strerror or exc}") from None
+    return path
+
+
+#: Files a run writes into its folder; a new run removes them first so none is left from an
+#: earlier run with other inputs (frames/ is a folder of the same kind).
+RESULT_FILES = ("path.csv", "summary.json", "centerline.csv", "branches.csv", "rod_path.csv", "fields.xdmf",
+                "fields.h5")
+RESULT_FOLDERS = ("frames",)
+
+#: summary.json "status": running (the run is in progress or was killed), complete, stopped (did
+#: not converge; the converged part is kept), interrupted (SIGINT/SIGTERM; the computed part kept).
+STATUS_RUNNING, STATUS_COMPLETE, STATUS_STOPPED, STATUS_INTERRUPTED = "running", "complete", "stopped", "interrupted"
+
+
+class RunFolder:
+    """An output folder over the life of one run.
+
+    - At creation (before any work): the folder is checked writable, the files of an earlier
+      run are removed and summary.json says status "running", converged false, so a killed run
+      can never be mistaken for a finished one.
+    - append(row): the row goes to path.csv at once (appended and flushed), so SIGKILL loses at
+      most the step being computed.
+    - checkpoint(summary): summary.json rewritten atomically, still "running".
+    - finish(result): every file rewritten atomically by result.write (path.csv whole).
+    """
+
+    def __init__(self, out, summary: dict | None = None, *, leading: tuple[str, ...] = (),
+                 trailing: tuple[str, ...] = (), name: str = "out"):
+        self.path = check_output_directory(out, name)
+        self.leading, self.trailing = tuple(leading), tuple(trailing)
+        self._columns: list[str] | None = None
+        self._handle = None
+        for file in RESULT_FILES:
+            (self.path / file).unlink(missing_ok=True)
+        for folder in RESULT_FOLDERS:
+            if (self.path / folder).is_dir():
+                import shutil
+
+                shutil.rmtree(self.path / folder, ignore_errors=True)
+        if summary is not None:
+            self.checkpoint(summary)
+
+    def checkpoint(self, summary: dict) -> None:
+        marked = dict(summary)
+        marked["status"] = STATUS_RUNNING
+        marked["converged"] = False
+        if not marked.get("message"):
+            marked["message"] = f"running (process {os.getpid()}); if no process runs, it was killed"
+        write_summary_json(self.path / "summary.json", marked)
+
+    def append(self, row: dict) -> None:
+        if self._columns is None:
+            self._columns = list(self.leading) + list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if c in row] \
+                + list(self.trailing)
+            self._handle = open(self.path / "path.csv", "w", newline="")
+            csv.writer(self._handle, lineterminator="\n").writerow(self._columns)
+        csv.writer(self._handle, lineterminator="\n").writerow([_format(row.get(c, "")) for c in self._columns])
+        self._handle.flush()
+
+    def close(self) -> None:
+        if self._handle is not None:
+            self._handle.close()
+            self._handle = None
+
+    def finish(self, result) -> None:
+        """Write the result's files atomically (signals held until done)."""
+        from .interrupts import deferred_signals
+
+        self.close()
+        with deferred_signals():
+            result.write(self.path)

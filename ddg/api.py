@@ -29,7 +29,7 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
     unstructured gmsh mesh with about `resolution` triangles; default the structured mesh.
     """
     cls = _model_class(name)
-    resolution = DEFAULT_RESOLUTION[name] if resolution is None else resolution
+    resolution = check_resolution(name, resolution)
     if mesh is None:
         return cls(strip, resolution)
     if name != "plate":
@@ -60,9 +60,7 @@ def _model_class(name: str):
     from .models.rod import RodModel
 
     models = {"rod": RodModel, "plate": PlateModel, "ribbon": RibbonModel}
-    if name not in models:
-        raise InputError(f"model = {name!r} is not available; choose one of {sorted(models)}")
-    return models[name]
+    return models[check_model_name(name)]
 
 
 @dataclass
@@ -143,6 +141,26 @@ def fill_thresholds(summary: dict, model, options, brackets: dict) -> None:
     summary["threshold_wall_time_s"] = time.perf_counter() - t0
 
 
+THRESHOLD_KEYS = ("dW1_over_L", "dW2_over_L", "dW2_S_stable_over_L")
+
+
+def check_thresholds_resolved(summary: dict, rows: list[dict]) -> None:
+    """Null every threshold located from states the discretisation does not resolve
+    (ddg.observables.unresolved_reason); its value and the reason go to
+    `unresolved_thresholds`, a line to `warnings`. No threshold is printed from such a state."""
+    from .observables import unresolved_reason
+
+    for key in THRESHOLD_KEYS:
+        value = summary.get(key)
+        if value is None:
+            continue
+        reason = unresolved_reason(rows, value)
+        if reason is not None:
+            summary[key] = None
+            summary["unresolved_thresholds"][key] = {"value": value, "reason": reason}
+            summary["warnings"].append(f"{key} = {value:.4g} not reported (unresolved): {reason}")
+
+
 def trace_all_branches(summary: dict, model, options, compressed, shear_max: float, brackets: dict) -> list[dict]:
     """Every branch of the shear stage by pseudo-arclength (ddg.solve.branches); its rows."""
     from .solve.branches import trace_branches
@@ -201,10 +219,90 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
         "wall_time_s": None,
         "converged": False,
         "message": "",
+        "status": "running",
+        "path_complete": False,
+        "warnings": [],
+        "unresolved_thresholds": {},
         "mesh": model.mesh.as_dict() if hasattr(model, "mesh") else None,
         "lambda_min_normalisation": "lowest eigenvalue of K v = lambda D v (lumped metric D), times L^4 / EI2",
         "versions": versions(),
     }
+
+
+def check_model_name(model) -> str:
+    """model as one of the available names (a one-line InputError otherwise)."""
+    if not isinstance(model, str) or model not in DEFAULT_RESOLUTION:
+        raise InputError(f"model = {model!r} is not available; choose one of {sorted(DEFAULT_RESOLUTION)}")
+    return model
+
+
+def check_resolution(model: str, resolution, strip: Strip | None = None, mesh=None) -> int:
+    """The resolution of `model` within what the model needs and the machine can run.
+
+    rod, ribbon: node count M in [MIN_NODES, MAX_NODES]; plate: target triangle count in
+    [16, MAX_TRIANGLES], its memory estimated (ddg.geometry.plate_mesh) and compared with the
+    memory available (ddg.limits.check_memory)."""
+    from .geometry.centerline import MIN_NODES
+    from .limits import check_integer
+
+    check_model_name(model)
+    if resolution is None:
+        return DEFAULT_RESOLUTION[model]
+    if model in ("rod", "ribbon"):
+        return check_integer("resolution (node count M)", resolution, MIN_NODES, MAX_NODES,
+                             "M = 200 already resolves the thresholds to 1e-4 L")
+    value = check_integer("resolution (target triangle count)", resolution, 16, MAX_TRIANGLES)
+    if strip is not None and (mesh is None or str(mesh) == "gmsh"):
+        from .geometry import plate_mesh
+        from .limits import check_memory
+
+        estimate = getattr(plate_mesh, "plate_memory_estimate_bytes", None)
+        if estimate is not None:
+            check_memory("resolution (target triangle count)", value, estimate(strip.length, strip.width, value))
+    return value
+
+
+#: Largest rod/ribbon node count: the error of the thresholds is ~1.8 / M^2 (dW1/L: 0.0044 at
+#: M = 20, 0.0020 at 30, 0.0006 at 50, measured); 5000 nodes cost ~40 s per path and gain nothing.
+MAX_NODES = 5000
+#: Largest plate triangle count accepted before the memory estimate is even consulted.
+MAX_TRIANGLES = 1_000_000
+
+
+def finish_summary(summary: dict, rows: list[dict], *, path_complete: bool, stopped: str | None,
+                   interrupted: BaseException | None, stage: str, error: BaseException | None = None) -> None:
+    """status, converged and message of a run that ended (every model's loop calls this).
+
+    path_complete: the loading path reached its end; stopped: the ContinuationFailure message if
+    it did not; interrupted: the KeyboardInterrupt (SIGINT/SIGTERM) that stopped the run, in
+    `stage`; error: an unexpected exception."""
+    from .interrupts import signal_name_of
+    from .io import STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED
+
+    summary["path_complete"] = bool(path_complete)
+    summary["recorded_steps"] = len(rows)
+    summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
+    kept = f"{len(rows)} converged steps written" if rows else "no step had converged"
+    if error is not None:
+        summary.update(status="error", converged=False,
+                       message=f"internal error during {stage}: {type(error).__name__}: {error}; {kept}")
+    elif interrupted is not None:
+        what = "the path is complete; " if path_complete else ""
+        summary.update(status=STATUS_INTERRUPTED, converged=False,
+                       message=f"interrupted by {signal_name_of(interrupted)} during {stage}; {what}{kept}")
+    elif stopped is not None:
+        summary.update(status=STATUS_STOPPED, converged=False, message=stopped)
+    else:
+        summary.update(status=STATUS_COMPLETE, converged=True, message="path complete")
+
+
+def open_run_folder(out, summary: dict, trailing: tuple[str, ...] = ()):
+    """The RunFolder of `out` (None if out is None), marked in progress with this summary."""
+    if out is None:
+        return None
+    from .io import RunFolder
+
+    return RunFolder(out, summary, trailing=trailing)
 
 
 def simulate(
@@ -228,11 +326,18 @@ def simulate(
     paper's implicit-Euler time marching (Eq. 7) with the clamp moved at a finite speed
     (rod only; see ddg.solve.dynamics). Returns every recorded equilibrium (rows of
     path.csv), the summary and the deformed centerline (w = 0) per row; writes them to `out`
-    (path.csv, summary.json, centerline.csv) if given, also when the run stops early (the
-    converged part of the path is kept). frames=True also writes out/frames/frame_NNNNN.vtu per
+    (path.csv, summary.json, centerline.csv) if given. `out` is checked writable before any
+    work; from the start summary.json says status "running" and path.csv grows by one row per
+    recorded step, so a killed run keeps every converged step and is never mistaken for a
+    finished one. A run that stops converging keeps the converged part (status "stopped");
+    Ctrl-C or SIGTERM (KeyboardInterrupt) writes what was computed (status "interrupted"),
+    then re-raises with the result attached as `exc.result`.
+    frames=True also writes out/frames/frame_NNNNN.vtu per
     recorded step and out/frames/frames.pvd (ParaView). mesh: see make_model. thresholds=True
     locates dW1 and dW2 from stability after the path (ddg.solve.thresholds; summary keys
-    dW1_over_L, dW2_over_L, dW2_S_stable_over_L) when the recorded path brackets them.
+    dW1_over_L, dW2_over_L, dW2_S_stable_over_L) when the recorded path brackets them; a
+    threshold whose states the discretisation does not resolve is reported null, with its
+    value and the reason under `unresolved_thresholds` and in `warnings`.
     branches=True (with thresholds; default None: True for the rod, False for the plate, whose
     diagram costs more than its path, 440 s against 265 s at 2000 triangles) then traces every branch of the shear stage by
     pseudo-arclength continuation, stable and unstable parts, through folds (U, US+, US-, and
@@ -240,8 +345,26 @@ def simulate(
     out/branches.csv (path.csv's columns after a `branch` column), per-branch summary under
     the summary key `branches`.
     """
-    if solver not in ("static", "dynamic"):
+    if not isinstance(strip, Strip):
+        raise InputError(f"strip = {strip!r} must be a ddg.Strip")
+    if not isinstance(protocol, LoadingProtocol):
+        raise InputError(f"protocol = {protocol!r} must be a ddg.LoadingProtocol")
+    if not isinstance(solver, str) or solver not in ("static", "dynamic"):
         raise InputError(f"solver = {solver!r} is not available; choose 'static' or 'dynamic'")
+    check_model_name(model)
+    if options is not None and not isinstance(options, ContinuationOptions):
+        raise InputError(f"options = {options!r} must be a ddg.ContinuationOptions")
+    for name, value in (("progress", progress), ("frames", frames), ("thresholds", thresholds)):
+        if not isinstance(value, (bool, np.bool_)):
+            raise InputError(f"{name} = {value!r} must be True or False")
+    if branches is not None and not isinstance(branches, (bool, np.bool_)):
+        raise InputError(f"branches = {branches!r} must be True, False or None")
+    resolution = check_resolution(model, resolution, strip, mesh)
+    shear_ratio = protocol.resolved_shear_ratio(strip)
+    if out is not None:
+        from .io import check_output_directory
+
+        check_output_directory(out)
     if solver == "dynamic":
         if model != "rod":
             raise InputError(f"solver = 'dynamic' is available for model 'rod' only, not {model!r}")
@@ -249,22 +372,13 @@ def simulate(
             raise InputError("frames and mesh are options of the static solver; drop them or use solver='static'")
         from .solve.dynamics import simulate_dynamic
 
-        result = simulate_dynamic(strip, protocol, DEFAULT_RESOLUTION["rod"] if resolution is None else resolution,
-                                  dynamic_options)
-        if out is not None:
-            result.write(out)
-        return result
-    if not isinstance(strip, Strip):
-        raise InputError(f"strip = {strip!r} must be a ddg.Strip")
-    if not isinstance(protocol, LoadingProtocol):
-        raise InputError(f"protocol = {protocol!r} must be a ddg.LoadingProtocol")
-    resolution = DEFAULT_RESOLUTION.get(model) if resolution is None else resolution
+        return simulate_dynamic(strip, protocol, resolution, dynamic_options, out=out)
+    if dynamic_options is not None:
+        raise InputError("dynamic_options apply to solver='dynamic' only")
     branches = (model != "plate") if branches is None else bool(branches)
-    shear_ratio = protocol.resolved_shear_ratio(strip)
     instance = make_model(model, strip, resolution, mesh)
     if frames and out is None:
         raise InputError("frames=True needs an output directory (out)")
-    writer = _frame_writer(instance, Path(out) / "frames") if frames else None
     options = options or ContinuationOptions()
     follower = PathFollower(instance, options)
     L = strip.length
@@ -273,8 +387,10 @@ def simulate(
 
     rows: list[dict] = []
     centerlines: list[np.ndarray] = []
-    progress_bar = ProgressBar(protocol.compression_steps + protocol.shear_steps + 1, progress)
     summary = base_summary(model, strip, protocol, resolution, instance)
+    folder = open_run_folder(out, summary)
+    writer = _frame_writer(instance, Path(out) / "frames") if frames else None
+    progress_bar = ProgressBar(protocol.compression_steps + protocol.shear_steps + 1, progress)
     t0 = time.perf_counter()
     state = None
 
@@ -285,6 +401,8 @@ def simulate(
     def record(stage):
         row = observe(instance, state, stage, options.eigenvalues)
         rows.append(row)
+        if folder is not None:
+            folder.append(row)
         if stage == "shear" and thresholds:
             track_brackets(brackets, instance, state, row["phase"])
         centerlines.append(instance.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
@@ -293,6 +411,7 @@ def simulate(
                          dW_over_L=row["dW_over_L"], stage=stage)
         progress_bar.update(f"{stage} dL/L={row['dL_over_L']:.4f} dW/L={row['dW_over_L']:.4f}")
 
+    stage, stopped, interrupted, error, path_complete = "compression", None, None, None, False
     try:
         state = follower.rest()
         record("compression")
@@ -304,30 +423,48 @@ def simulate(
         from .solve.thresholds import Snapshot
 
         compressed = Snapshot.take(instance, state)
+        if folder is not None:
+            folder.checkpoint({**summary, "message": "running: compression complete, shearing"})
+        stage = "shear"
         for k in range(1, protocol.shear_steps + 1 if dW != 0.0 else 1):
             state = follower.advance(state, dL, dW * k / protocol.shear_steps)
             record("shear")
-        summary["converged"] = True
-        summary["message"] = "path complete"
+        path_complete = True
     except ContinuationFailure as exc:
-        summary["message"] = str(exc)
-    except KeyboardInterrupt:
-        summary["message"] = "interrupted"
-        raise
-    finally:
-        progress_bar.close()
-        if thresholds and options.eigenvalues and state is not None and summary["message"] != "interrupted":
+        stopped = str(exc)
+    except KeyboardInterrupt as exc:
+        interrupted = exc
+    except Exception as exc:  # noqa: BLE001  (written as status "error", then re-raised)
+        error = exc
+    progress_bar.close()
+    try:
+        if interrupted is None and error is None and thresholds and options.eigenvalues and state is not None:
+            if folder is not None:
+                folder.checkpoint({**summary, "message": "running: path done, locating thresholds"})
+            stage = "threshold location"
             fill_thresholds(summary, instance, options, brackets)
+            check_thresholds_resolved(summary, rows)
             if branches and compressed is not None and dW != 0.0:
+                stage = "branch tracing"
+                if folder is not None:
+                    folder.checkpoint({**summary, "message": "running: thresholds located, tracing branches"})
                 branch_rows = trace_all_branches(summary, instance, options, compressed, dW, brackets)
-        summary["newton_iterations"] = follower.newton_iterations
-        summary["folds_dW_over_L"] = _distinct([abs(f) / L for f in follower.folds], 1e-4)
-        summary["wall_time_s"] = time.perf_counter() - t0
-        summary["recorded_steps"] = len(rows)
-        summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
-        if writer is not None:
-            writer.close()
-        result = SimulationResult(rows, summary, state, instance, centerlines, branch_rows)
-        if out is not None:
-            result.write(out)
+    except KeyboardInterrupt as exc:
+        interrupted = exc
+    except Exception as exc:  # noqa: BLE001
+        error = exc
+    summary["newton_iterations"] = follower.newton_iterations
+    summary["folds_dW_over_L"] = _distinct([abs(f) / L for f in follower.folds], 1e-4)
+    summary["wall_time_s"] = time.perf_counter() - t0
+    finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
+                   stage=stage, error=error)
+    if writer is not None:
+        writer.close()
+    result = SimulationResult(rows, summary, state, instance, centerlines, branch_rows)
+    if folder is not None:
+        folder.finish(result)
+    if interrupted is not None or error is not None:
+        raised = interrupted if interrupted is not None else error
+        raised.result = result
+        raise raised
     return result

@@ -1,8 +1,10 @@
 """Command line: `python -m ddg simulate ...`, a thin layer over ddg.simulate; `python -m ddg
 curvatures ...` and `python -m ddg centerline-error ...` (ddg.curvatures, ddg.centerline_approx).
 
-Exit codes: 0 path complete; 2 bad arguments (one-line message); 3 the run stopped
-converging (the converged part of the path is written, the message says where).
+Exit codes: 0 path complete; 2 bad arguments (one-line message, before any work); 3 the run
+stopped converging (the converged part of the path is written, the message says where); 130 or
+143 interrupted by SIGINT or SIGTERM (every converged step written); 1 an internal error (one
+line; DDG_TRACEBACK=1 shows the traceback).
 """
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from .geometry.strip import InputError, LoadingProtocol, Strip
 
 EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
+EXIT_INTERNAL = 1
 
 
 class _Parser(argparse.ArgumentParser):
@@ -64,7 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
                      help="stay on the branch the path starts on, even where it is unstable")
     sim.add_argument("--solver", choices=("static", "dynamic"), default="static",
                      help="static Newton continuation (default) or the paper's implicit-Euler time marching (rod)")
-    sim.add_argument("--clamp-speed", type=float, default=1e-3, help="dynamic solver: clamp speed in m/s (default 1e-3)")
+    sim.add_argument("--clamp-speed", type=float, default=None, help="dynamic solver: clamp speed in m/s (default 1e-3)")
     sim.add_argument("--max-newton-iterations", type=int, default=15, help="per load step (default 15)")
     sim.add_argument("--out", default="out", help="output directory (default ./out)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar or result print-out")
@@ -100,16 +103,59 @@ def _ratios(name: str, text: str, low: float, high: float, low_inclusive: bool =
     return check_ratios(name, [v for v in str(text).split(",") if v.strip()] or [text], low, high, low_inclusive)
 
 
+#: Most centerline stations a plate profile may ask for (a profile finer than the mesh columns
+#: only interpolates; 10000 is far beyond any mesh the machine can run).
+MAX_STATIONS = 10000
+
+
+def _within_shear_limit(name: str, shears: list[float], strip: Strip, compression_ratio: float) -> None:
+    limit = strip.shear_limit(compression_ratio * strip.length) / strip.length
+    for shear in shears:
+        if shear > limit * (1.0 + 1e-12):
+            raise InputError(f"{name} dW/L = {shear:g} beyond the shear limit dW_max/L = {limit:.6g} (Eq. B.1) for "
+                             f"W/L = {strip.width_ratio:.4g}, dL/L = {compression_ratio:g}; allowed [0, {limit:.6g}]")
+
+
+def _check_zeta(zeta) -> None:
+    if zeta is not None:
+        from .energies.sadowsky import check_zeta
+
+        check_zeta(zeta)
+
+
+def _output_directory(out) -> Path:
+    from .io import check_output_directory
+
+    return check_output_directory(out, "--out")
+
+
+def _require_extra(module: str, extra: str) -> None:
+    import importlib.util
+
+    if importlib.util.find_spec(module) is None:
+        raise InputError(f"this command needs {module}: pip install 'ddg-strips[{extra}]' (or Debian's python3-{module})")
+
+
 def cmd_curvatures(args) -> int:
     """Curvature profiles at the requested shears: OUT/curvatures.csv and OUT/curvatures.png."""
     from .curvatures import centerline_curvatures, inflection_jumps, states_at_shears, write_curvatures_csv
 
+    from .api import check_resolution
+    from .limits import check_integer
+
     strip = Strip.from_ratios(args.width_ratio, args.compression_ratio, args.slenderness)
     shears = _ratios("--shear-ratios dW/L", args.shear_ratios, 0.0, 1.0, low_inclusive=True)
+    _within_shear_limit("--shear-ratios", shears, strip, args.compression_ratio)
     if args.model != "ribbon" and args.zeta is not None:
         raise InputError(f"--zeta applies to --model ribbon only, not {args.model!r}")
     if args.stations is not None and args.model != "plate":
         raise InputError(f"--stations applies to --model plate only, not {args.model!r}")
+    if args.stations is not None:
+        check_integer("--stations", args.stations, 3, MAX_STATIONS)
+    _check_zeta(args.zeta)
+    check_resolution(args.model, args.resolution, strip)
+    out = _output_directory(args.out)
+    _require_extra("matplotlib", "plot")
     records = []
     states = states_at_shears(args.model, strip, args.compression_ratio, shears, args.resolution,
                               ribbon_init=args.ribbon_init, zeta=args.zeta)
@@ -119,7 +165,6 @@ def cmd_curvatures(args) -> int:
         records.append({"model": args.model, "step": step, "dL_over_L": state.compression / strip.length,
                         "dW_over_L": state.shear / strip.length, "profile": profile,
                         "inflections": inflection_jumps(profile)})
-    out = Path(args.out)
     write_curvatures_csv(out / "curvatures.csv", records)
     import matplotlib
 
@@ -155,10 +200,17 @@ def cmd_centerline_error(args) -> int:
     from .centerline_approx import centerline_error_study
     from .io import atomic_write_text
 
+    from .api import check_resolution
+
     widths = _ratios("--width-ratios W/L", args.width_ratios, 0.0, 1.0)
     shears = _ratios("--shear-ratios dW/L", args.shear_ratios, 0.0, 1.0)
+    for width in widths:
+        strip = Strip.from_ratios(width, args.compression_ratio, args.slenderness)
+        _within_shear_limit("--shear-ratios", shears, strip, args.compression_ratio)
+        check_resolution("plate", args.resolution, strip)
+    out = _output_directory(args.out)
+    _require_extra("matplotlib", "plot")
     rows = centerline_error_study(widths, shears, args.compression_ratio, args.resolution, args.slenderness)
-    out = Path(args.out)
     columns = ("L_over_W", "W_over_L", "dW_over_L", "mean_error", "max_error", "rod_edge_mean_error",
                "ribbon_edge_mean_error", "phase", "triangles", "message")
     buf = _io.StringIO()
@@ -185,6 +237,11 @@ def cmd_centerline_error(args) -> int:
         print(f"L/W = {r['L_over_W']:.3g}  dW/L = {r['dW_over_L']:.3g}  mean {r['mean_error']:.3e}  max {r['max_error']:.3e}"
               f"  {r['phase']} {r['message']}")
     print(f"wrote {out / 'centerline_error.csv'} and {out / 'centerline_error.png'}")
+    failed = [r for r in rows if r["message"]]
+    if failed:
+        sys.stderr.write(f"error: {len(failed)} of {len(rows)} rows did not converge (their errors are empty): "
+                         f"{failed[0]['message']}\n")
+        return EXIT_NOT_CONVERGED
     return 0
 
 
@@ -193,12 +250,24 @@ def cmd_simulate(args) -> int:
     from .solve.continuation import ContinuationOptions
     from .solve.newton import NewtonOptions
 
+    from .api import check_resolution
+    from .limits import check_integer
+
     strip = Strip.from_ratios(args.width_ratio, args.compression_ratio, args.slenderness,
                               young_modulus=args.young_modulus, poisson_ratio=args.poisson_ratio)
     protocol = LoadingProtocol(args.compression_ratio, args.shear_ratio, args.compression_steps, args.shear_steps,
                                args.shear_direction)
-    if args.max_newton_iterations < 1:
-        raise InputError(f"--max-newton-iterations = {args.max_newton_iterations} must be >= 1")
+    protocol.resolved_shear_ratio(strip)
+    check_integer("--max-newton-iterations", args.max_newton_iterations, 1, 1000)
+    check_resolution(args.model, args.resolution, strip, args.mesh)
+    _check_zeta(args.zeta)
+    if args.mesh is not None and args.model != "plate":
+        raise InputError(f"--mesh applies to --model plate only, not {args.model!r}")
+    if args.solver == "dynamic" and args.model != "rod":
+        raise InputError(f"--solver dynamic is available for --model rod only, not {args.model!r}")
+    if args.solver != "dynamic" and args.clamp_speed is not None:
+        raise InputError("--clamp-speed applies to --solver dynamic only")
+    _output_directory(args.out)
     options = ContinuationOptions(newton=NewtonOptions(max_iterations=args.max_newton_iterations),
                                   branch_switching=not args.no_branch_switching,
                                   branch_sign=1 if args.branch == "+" else -1)
@@ -206,9 +275,8 @@ def cmd_simulate(args) -> int:
     if args.solver == "dynamic":
         from .solve.dynamics import DynamicOptions
 
-        if not args.clamp_speed > 0:
-            raise InputError(f"--clamp-speed = {args.clamp_speed} must be a positive speed in m/s")
-        dynamic_options = DynamicOptions(clamp_speed=args.clamp_speed)
+        dynamic_options = DynamicOptions(clamp_speed=1e-3 if args.clamp_speed is None else args.clamp_speed)
+        dynamic_options.check_scene(strip, protocol)
     if args.model == "ribbon":
         from .ribbon_runs import run_ribbon
 
@@ -227,8 +295,10 @@ def cmd_simulate(args) -> int:
     if not args.quiet:
         keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
                 "newton_iterations", "wall_time_s", "converged", "message")
-        print(json.dumps({k: s[k] for k in keys}, indent=2))
+        print(json.dumps({k: s.get(k) for k in keys}, indent=2))
         print(f"wrote {Path(args.out) / 'path.csv'} and {Path(args.out) / 'summary.json'}")
+    for warning in s.get("warnings") or ():
+        sys.stderr.write(f"warning: {warning}\n")
     if not result.converged:
         sys.stderr.write(f"error: run did not complete: {s['message']}; converged part kept in {args.out}\n")
         return EXIT_NOT_CONVERGED
@@ -236,16 +306,54 @@ def cmd_simulate(args) -> int:
 
 
 def main(argv=None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """The command line; returns the exit code (0 complete, 2 bad input, 3 not converged,
+    130/143 interrupted by SIGINT/SIGTERM with every converged step written, 1 internal error)."""
+    import os
+    import signal as _signal
+
+    from .interrupts import exit_code_of, signal_name_of, terminate_as_interrupt
+    from .solve.continuation import ContinuationFailure
+
+    previous = {sig: _signal.getsignal(sig) for sig in (_signal.SIGINT, _signal.SIGTERM)}
+    terminate_as_interrupt()
     try:
+        parser = build_parser()
+        args = parser.parse_args(argv)
         if args.command == "simulate":
             return cmd_simulate(args)
         if args.command == "curvatures":
             return cmd_curvatures(args)
         if args.command == "centerline-error":
             return cmd_centerline_error(args)
-    except InputError as exc:
-        sys.stderr.write(f"error: {exc}\n")
         return EXIT_BAD_INPUT
-    return EXIT_BAD_INPUT
+    except InputError as exc:
+        sys.stderr.write(f"error: {_one_line(exc)}\n")
+        return EXIT_BAD_INPUT
+    except ContinuationFailure as exc:
+        sys.stderr.write(f"error: run did not complete: {_one_line(exc)}\n")
+        return EXIT_NOT_CONVERGED
+    except KeyboardInterrupt as exc:
+        result = getattr(exc, "result", None)
+        kept = f": {result.summary['message']}" if result is not None else ""
+        sys.stderr.write(f"error: interrupted by {signal_name_of(exc)}{kept}\n")
+        return exit_code_of(exc)
+    except MemoryError:
+        sys.stderr.write("error: out of memory; lower --resolution\n")
+        return EXIT_INTERNAL
+    except Exception as exc:  # noqa: BLE001  (one line, never a traceback; DDG_TRACEBACK=1 shows it)
+        if os.environ.get("DDG_TRACEBACK"):
+            raise
+        sys.stderr.write(f"error: internal error: {type(exc).__name__}: {_one_line(exc)} "
+                         "(set DDG_TRACEBACK=1 for the traceback)\n")
+        return EXIT_INTERNAL
+    finally:
+        import threading
+
+        if threading.current_thread() is threading.main_thread():
+            for sig, handler in previous.items():
+                if handler is not None:
+                    _signal.signal(sig, handler)
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split())

@@ -12,10 +12,7 @@ import os
 
 from .geometry.strip import InputError
 
-#: Largest recorded steps per stage. A recorded step costs an eigenvalue solve and an
-#: observation (3-10 ms on the rod, ~0.1 s on a 2000-triangle plate): 5000 steps are minutes,
-#: 1e5 would be hours with nothing gained (the continuation subdivides steps where it must).
-MAX_RECORDED_STEPS = 5000
+from .geometry.strip import MAX_RECORDED_STEPS  # noqa: F401  (re-exported: one bound for every stepper)
 
 #: Fraction of the memory available now that one run may plan to use.
 MEMORY_FRACTION = 0.5

@@ -19,14 +19,14 @@ from pathlib import Path
 
 import numpy as np
 
-from .api import (CENTERLINE_STATIONS, DEFAULT_RESOLUTION, SimulationResult, fill_thresholds, ProgressBar,
-                  track_brackets, base_summary)
+from .api import (CENTERLINE_STATIONS, SimulationResult, base_summary, check_resolution, check_thresholds_resolved,
+                  fill_thresholds, finish_summary, open_run_folder, ProgressBar, track_brackets)
 from .geometry.frames import cross, rowdot
 from .geometry.strip import InputError, LoadingProtocol, Strip
 from .io import write_path_csv
 from .models.ribbon import RibbonModel
 from .models.rod import RodModel
-from .observables import observe, resolved_up_to
+from .observables import observe
 from .solve.continuation import ContinuationFailure, ContinuationOptions, PathFollower, State
 from .solve.newton import newton
 from .solve.stability import lowest_modes
@@ -73,7 +73,13 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
         raise InputError(f"ribbon init = {init!r} is not available; choose one of {list(RIBBON_INITS)}")
     if not isinstance(strip, Strip) or not isinstance(protocol, LoadingProtocol):
         raise InputError("run_ribbon needs a ddg.Strip and a ddg.LoadingProtocol")
-    resolution = DEFAULT_RESOLUTION["rod"] if resolution is None else resolution
+    resolution = check_resolution("ribbon", resolution)
+    if out is not None:
+        from .io import check_output_directory
+
+        check_output_directory(out)
+    if options is not None and not isinstance(options, ContinuationOptions):
+        raise InputError(f"options = {options!r} must be a ddg.ContinuationOptions")
     options = options or ContinuationOptions()
     ribbon = RibbonModel(strip, resolution, zeta=zeta)
     rod = RodModel(strip, resolution) if init == "rod" else None
@@ -84,6 +90,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     dW = protocol.shear_sign * protocol.resolved_shear_ratio(strip) * L
     summary = base_summary("ribbon", strip, protocol, resolution, ribbon)
     summary.update(ribbon_init=init, zeta=ribbon.zeta, zeta_over_L=ribbon.zeta / L)
+    folder = open_run_folder(out, summary)
     rows, rod_rows, centerlines = [], [], []
     brackets = {"last_u": None, "first_us": None, "last_us": None, "first_s": None}
     bar = ProgressBar(protocol.compression_steps + protocol.shear_steps + 1, progress)
@@ -95,18 +102,23 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
         nonlocal state, relax_iterations
         if rod is not None:
             rod_rows.append(observe(rod, driven, stage, options.eigenvalues))
+            if stage == "shear" and thresholds:
+                track_brackets(brackets, rod, driven, rod_rows[-1]["phase"])
             state = relax_from(ribbon, rod, driven, options)
             relax_iterations += state.iterations
         else:
             state = driven
         row = observe(ribbon, state, stage, options.eigenvalues)
         rows.append(row)
+        if folder is not None:
+            folder.append(row)
         if stage == "shear" and thresholds and rod is None:
             track_brackets(brackets, ribbon, state, row["phase"])
         centerlines.append(ribbon.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
         bar.update(f"{stage} dL/L={row['dL_over_L']:.4f} dW/L={row['dW_over_L']:.4f}")
 
     driven = None
+    stage, stopped, interrupted, error, path_complete = "compression", None, None, None, False
     try:
         driven = follower.rest()
         record("compression", driven)
@@ -115,25 +127,55 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
             driven = follower.start_compression(target) if k == 1 else follower.advance(driven, target, 0.0)
             record("compression", driven)
         summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
+        stage = "shear"
         for k in range(1, protocol.shear_steps + 1 if dW != 0.0 else 1):
             driven = follower.advance(driven, dL, dW * k / protocol.shear_steps)
             record("shear", driven)
-        summary["converged"] = True
-        summary["message"] = "path complete"
+        path_complete = True
     except ContinuationFailure as exc:
-        summary["message"] = str(exc)
-    finally:
-        bar.close()
-        if thresholds and options.eigenvalues and state is not None and rod is None:
-            fill_thresholds(summary, ribbon, options, brackets)
-        summary["newton_iterations"] = follower.newton_iterations + relax_iterations
-        summary["wall_time_s"] = time.perf_counter() - t0
-        summary["recorded_steps"] = len(rows)
-        summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
-        result = RibbonResult(rows, summary, state, ribbon, centerlines, rod_rows=rod_rows)
-        if out is not None:
-            result.write(out)
+        stopped = str(exc)
+    except KeyboardInterrupt as exc:
+        interrupted = exc
+    except Exception as exc:  # noqa: BLE001  (written as status "error", then re-raised)
+        error = exc
+    bar.close()
+    try:
+        if interrupted is None and error is None and thresholds and options.eigenvalues and state is not None:
+            stage = "threshold location"
+            if rod is None:
+                fill_thresholds(summary, ribbon, options, brackets)
+                check_thresholds_resolved(summary, rows)
+            else:
+                rod_thresholds(summary, rod, options, brackets, rod_rows)
+    except KeyboardInterrupt as exc:
+        interrupted = exc
+    except Exception as exc:  # noqa: BLE001
+        error = exc
+    summary["newton_iterations"] = follower.newton_iterations + relax_iterations
+    summary["wall_time_s"] = time.perf_counter() - t0
+    finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
+                   stage=stage, error=error)
+    result = RibbonResult(rows, summary, state, ribbon, centerlines, rod_rows=rod_rows)
+    if folder is not None:
+        folder.finish(result)
+    if interrupted is not None or error is not None:
+        raised = interrupted if interrupted is not None else error
+        raised.result = result
+        raise raised
     return result
+
+
+def rod_thresholds(summary: dict, rod, options: ContinuationOptions, brackets: dict, rod_rows: list[dict]) -> None:
+    """The thresholds of the rod that drove a rod-initialised ribbon run, located from the rod's
+    stability as ddg.simulate does (summary keys rod_dW1_over_L, rod_dW2_over_L,
+    rod_dW2_S_stable_over_L); the ribbon's own stay null: it follows the rod's branch choice."""
+    found = {"warnings": [], "unresolved_thresholds": {}}
+    fill_thresholds(found, rod, options, brackets)
+    check_thresholds_resolved(found, rod_rows)
+    for key in ("dW1_over_L", "dW2_over_L", "dW2_S_stable_over_L"):
+        summary[f"rod_{key}"] = found[key]
+    summary["threshold_wall_time_s"] = found["threshold_wall_time_s"]
+    summary["warnings"].extend(f"rod: {w}" for w in found["warnings"])
 
 
 # ---------------------------------------------------------------------- why direct misses dW1

@@ -25,14 +25,22 @@ from .rod_curvature import StencilGeometry, curvature_derivatives
 from .rod_twist import twist_derivatives
 
 
+ZETA_RANGE = (1e-9, 1e9)
+
+
 def check_zeta(zeta) -> float:
-    """zeta as a positive finite float (m), else InputError."""
+    """zeta (m) within ZETA_RANGE, else InputError. 1/zeta^2 must stay a normal float well above
+    round-off of k2^2 and below overflow: 1e-9 m to 1e9 m (the paper's 1e8; results stop
+    changing from zeta ~ 10 L)."""
+    low, high = ZETA_RANGE
+    if isinstance(zeta, bool):
+        raise InputError(f"zeta = {zeta!r} is a bool; allowed: a length in [{low:g}, {high:g}] m")
     try:
         value = float(zeta)
-    except (TypeError, ValueError):
-        raise InputError(f"zeta = {zeta!r} is not a number; allowed: a positive finite length in metres") from None
-    if not (np.isfinite(value) and value > 0.0):
-        raise InputError(f"zeta = {zeta!r} outside the allowed range (0, inf) m")
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"zeta = {zeta!r} is not a number; allowed: a length in [{low:g}, {high:g}] m") from None
+    if not (np.isfinite(value) and low <= value <= high):
+        raise InputError(f"zeta = {zeta!r} outside the allowed range [{low:g}, {high:g}] m")
     return value
 
 

@@ -15,6 +15,11 @@ CLAMP_SPAN_AFTER_COMPRESSION = 75e-3
 PAPER_THICKNESS = 0.127e-3
 PAPER_YOUNG_MODULUS = 100e9
 
+#: Largest recorded steps per stage. A recorded step costs an eigenvalue solve and an observation
+#: (3-10 ms on the rod, ~0.1 s on a 2000-triangle plate): 5000 steps take minutes; 1e5 would take
+#: hours and gain nothing (the continuation subdivides steps where it must).
+MAX_RECORDED_STEPS = 5000
+
 
 class InputError(ValueError):
     """A scene or solver input outside its allowed range (one-line message)."""
@@ -26,12 +31,39 @@ def _require(condition: bool, message: str) -> None:
 
 
 def _finite_positive(name: str, value: float) -> float:
+    if isinstance(value, bool):
+        raise InputError(f"{name} = {value!r} is a bool; it must be a positive number")
     try:
         value = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError(f"{name} = {value!r} is not a number; it must be a positive number") from None
     _require(math.isfinite(value) and value > 0.0, f"{name} = {value!r} must be a positive finite number")
     return value
+
+
+def _within(name: str, value: float, low: float, high: float, unit: str, why: str) -> float:
+    _require(low <= value <= high, f"{name} = {value:g}{unit} outside the allowed range [{low:g}, {high:g}]{unit}; {why}")
+    return value
+
+
+#: Physical ranges checked when a Strip is built (SI). They keep every derived stiffness and
+#: energy far inside the float range and the scene inside the models' validity:
+#: - length: 1 um to 1 km (energies scale as E b^3 W / L; beyond these the 1e-300..1e300 range
+#:   of doubles is approached by products such as E A L^2 only far outside them);
+#: - Young's modulus: 1 kPa (soft gels) to 10 TPa (above diamond's 1.2 TPa);
+#: - density: 1 to 1e5 kg/m^3 (used by the dynamic solver only);
+#: - slenderness L/b: 10 to 1e5. Below 10 the strip is no longer thin (rod and plate theories
+#:   need b << L); above 1e5 the stretching-to-bending stiffness ratio of an element,
+#:   12 (h/b)^2, exceeds ~1e9 at M = 100 and Newton's residual hits round-off (the paper's
+#:   strips are L/b = 787 and 1181).
+LENGTH_RANGE = (1e-6, 1e3)
+YOUNG_MODULUS_RANGE = (1e3, 1e13)
+DENSITY_RANGE = (1.0, 1e5)
+SLENDERNESS_RANGE = (10.0, 1e5)
+#: dL/L: at least 1e-3 (below it the buckle is a small perturbation of the flat strip, H_mid/L <
+#: 0.02, and for thick strips not even past the Euler load, whose shortening is pi^2/3 (b/L)^2);
+#: at most 0.9: beyond, the clamped elastica's loop closes on itself (self-contact, not modelled).
+COMPRESSION_RATIO_RANGE = (1e-3, 0.9)
 
 
 def shear_limit(length: float, width: float, compression: float) -> float:
@@ -61,12 +93,18 @@ class Strip:
         for name in ("length", "width", "thickness", "young_modulus", "density"):
             object.__setattr__(self, name, _finite_positive(name, getattr(self, name)))
         nu = self.poisson_ratio
+        if isinstance(nu, bool):
+            raise InputError(f"poisson_ratio = {nu!r} is a bool; allowed range [0, 0.5)")
         try:
             nu = float(nu)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise InputError(f"poisson_ratio = {nu!r} is not a number; allowed range [0, 0.5)") from None
         _require(math.isfinite(nu) and 0.0 <= nu < 0.5, f"poisson_ratio = {nu!r} outside the allowed range [0, 0.5)")
         object.__setattr__(self, "poisson_ratio", nu)
+        _within("length L", self.length, *LENGTH_RANGE, " m", "the scene is scale-free: give L in metres")
+        _within("young_modulus E", self.young_modulus, *YOUNG_MODULUS_RANGE, " Pa",
+                "from soft gels to above diamond; the geometry does not depend on E")
+        _within("density", self.density, *DENSITY_RANGE, " kg/m^3", "used by the dynamic solver")
         _require(
             self.width <= self.length,
             f"width W = {self.width:g} m exceeds length L = {self.length:g} m; allowed 0 < W <= L",
@@ -75,6 +113,8 @@ class Strip:
             self.thickness < self.width,
             f"thickness b = {self.thickness:g} m must be smaller than width W = {self.width:g} m (0 < b < W)",
         )
+        _within("slenderness L/b", self.length / self.thickness, *SLENDERNESS_RANGE, "",
+                "a thin strip (b << L) whose stretching and bending stiffnesses stay within round-off of each other")
 
     @classmethod
     def from_ratios(
@@ -88,10 +128,17 @@ class Strip:
 
         L = 75 mm / (1 - dL/L); b = L / slenderness, default b = 0.127 mm.
         """
-        compression_ratio = _ratio("compression_ratio dL/L", compression_ratio, 0.0, 1.0)
+        compression_ratio = _compression_ratio(compression_ratio)
         width_ratio = _ratio("width_ratio W/L", width_ratio, 0.0, 1.0, upper_inclusive=True)
         length = CLAMP_SPAN_AFTER_COMPRESSION / (1.0 - compression_ratio)
-        thickness = PAPER_THICKNESS if slenderness is None else length / _finite_positive("slenderness L/b", slenderness)
+        if slenderness is None:
+            thickness = PAPER_THICKNESS
+        else:
+            slenderness = _finite_positive("slenderness L/b", slenderness)
+            low, high = SLENDERNESS_RANGE
+            _require(low <= slenderness <= high, f"slenderness L/b = {slenderness:g} outside the allowed range "
+                     f"[{low:g}, {high:g}]: a thin strip (b << L) within round-off of double precision")
+            thickness = length / slenderness
         return cls(length=length, width=width_ratio * length, thickness=thickness, **material)
 
     # --- derived quantities -------------------------------------------------------------
@@ -159,9 +206,11 @@ class Strip:
 
 
 def _ratio(name: str, value, low: float, high: float, upper_inclusive: bool = False) -> float:
+    if isinstance(value, bool):
+        raise InputError(f"{name} = {value!r} is a bool, not a number")
     try:
         value = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise InputError(f"{name} = {value!r} is not a number") from None
     upper_ok = value <= high if upper_inclusive else value < high
     bracket = "]" if upper_inclusive else ")"
@@ -169,6 +218,15 @@ def _ratio(name: str, value, low: float, high: float, upper_inclusive: bool = Fa
         math.isfinite(value) and value > low and upper_ok,
         f"{name} = {value!r} outside the allowed range ({low:g}, {high:g}{bracket}",
     )
+    return value
+
+
+def _compression_ratio(value) -> float:
+    """dL/L in COMPRESSION_RATIO_RANGE (see there)."""
+    value = _ratio("compression_ratio dL/L", value, 0.0, 1.0)
+    low, high = COMPRESSION_RATIO_RANGE
+    _require(low <= value <= high, f"compression_ratio dL/L = {value!r} outside the allowed range [{low:g}, {high:g}]: "
+             "below it the strip is barely buckled, above it the elastica closes on itself (self-contact, not modelled)")
     return value
 
 
@@ -189,18 +247,22 @@ class LoadingProtocol:
     shear_sign: int = 1
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "compression_ratio", _ratio("compression_ratio dL/L", self.compression_ratio, 0.0, 1.0))
-        for name, low in (("compression_steps", 1), ("shear_steps", 1)):
+        object.__setattr__(self, "compression_ratio", _compression_ratio(self.compression_ratio))
+        for name in ("compression_steps", "shear_steps"):
             value = getattr(self, name)
             _require(
-                isinstance(value, int) and not isinstance(value, bool) and value >= low,
-                f"{name} = {value!r} must be an integer >= {low}",
+                isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= MAX_RECORDED_STEPS,
+                f"{name} = {value!r} must be an integer in [1, {MAX_RECORDED_STEPS}] (an integer >= 1; more "
+                "recorded steps cost time and add nothing: the solver subdivides where it must)",
             )
-        _require(self.shear_sign in (1, -1), f"shear_sign = {self.shear_sign!r} must be +1 or -1")
+        _require(not isinstance(self.shear_sign, bool) and self.shear_sign in (1, -1),
+                 f"shear_sign = {self.shear_sign!r} must be +1 or -1")
         if self.shear_ratio is not None:
+            if isinstance(self.shear_ratio, bool):
+                raise InputError(f"shear_ratio = {self.shear_ratio!r} is a bool, not a number")
             try:
                 value = float(self.shear_ratio)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 raise InputError(f"shear_ratio = {self.shear_ratio!r} is not a number") from None
             _require(math.isfinite(value) and value >= 0.0, f"shear_ratio dW/L = {value!r} must be >= 0")
             object.__setattr__(self, "shear_ratio", value)

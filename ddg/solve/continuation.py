@@ -15,7 +15,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .newton import NewtonOptions, newton
+from ..geometry.strip import InputError
+from .newton import NewtonOptions, check_option, newton
 from .stability import lowest_modes
 
 
@@ -45,6 +46,26 @@ class ContinuationOptions:
     predictor: str = "secant"          # "secant" (extrapolate the branch), "tangent", or "both" (secant, then tangent)
     grow_after: int = 2                # easy substeps in a row before the substep doubles
     branch_sign: int = 1               # +1: leave a pitchfork onto the '+' branch (US+), -1: onto US-
+
+    PREDICTORS = ("secant", "tangent", "both")
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.newton, NewtonOptions):
+            raise InputError(f"ContinuationOptions(newton={self.newton!r}): must be a ddg.NewtonOptions")
+        c = lambda name, *args, **kw: setattr(self, name, check_option("ContinuationOptions", name, getattr(self, name),
+                                                                      *args, **kw))  # noqa: E731
+        # below 2^-30 of a recorded interval the substeps are lost in round-off of the load
+        c("min_substep", "float", 2.0**-30, 1.0)
+        c("easy_iterations", "int", 0, 1000)
+        c("branch_switching", "bool")
+        c("eigenvalues", "bool")
+        c("kick", "float", 0.0, MAX_KICK, low_open=True)
+        c("jump_substep", "float", 0.0, 1.0, low_open=True)
+        c("grow_after", "int", 1, 1000)
+        if self.predictor not in self.PREDICTORS:
+            raise InputError(f"ContinuationOptions(predictor={self.predictor!r}): choose one of {list(self.PREDICTORS)}")
+        if isinstance(self.branch_sign, bool) or self.branch_sign not in (1, -1):
+            raise InputError(f"ContinuationOptions(branch_sign={self.branch_sign!r}): must be +1 (US+, S+) or -1 (US-, S-)")
 
 
 @dataclass
@@ -206,7 +227,8 @@ class PathFollower:
         if patient:
             # near thresholds Newton converges only linearly: more iterations, a milder give-up test
             give_up = 2 * opts.give_up_after if opts.give_up_after else None
-            opts = replace(opts, max_iterations=2 * opts.max_iterations, give_up_after=give_up, give_up_ratio=0.5)
+            opts = replace(opts, max_iterations=min(2 * opts.max_iterations, 1000), give_up_after=give_up,
+                           give_up_ratio=0.5)
         result = None
         extrapolated = None
         if self.options.predictor != "tangent" and self._history and np.array_equal(state.q, self._history[-1][1]):

@@ -28,9 +28,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..api import SimulationResult, base_summary
+from ..api import SimulationResult, base_summary, finish_summary, open_run_folder
 from ..geometry.strip import InputError, LoadingProtocol, Strip
-from ..observables import observe, resolved_up_to
+from ..observables import observe
 from .banded import SymmetricBanded
 from .continuation import ContinuationFailure, ContinuationOptions, PathFollower, State
 from .newton import NewtonOptions, newton, scaled_residual
@@ -100,8 +100,37 @@ class DynamicOptions:
             raise InputError(f"damping = {self.damping!r} must be a finite number >= 0 (1/s)")
         if self.record_interval is not None and not (math.isfinite(self.record_interval) and self.record_interval > 0):
             raise InputError(f"record_interval = {self.record_interval!r} must be None or a positive number (s)")
-        if not (isinstance(self.max_halvings, int) and self.max_halvings >= 0):
-            raise InputError(f"max_halvings = {self.max_halvings!r} must be an integer >= 0")
+        if not (isinstance(self.max_halvings, int) and not isinstance(self.max_halvings, bool)
+                and 0 <= self.max_halvings <= 30):
+            raise InputError(f"max_halvings = {self.max_halvings!r} must be an integer in [0, 30]")
+        for name in ("relax_start", "eigenvalues"):
+            if not isinstance(getattr(self, name), bool):
+                raise InputError(f"{name} = {getattr(self, name)!r} must be True or False")
+        if not isinstance(self.newton, NewtonOptions):
+            raise InputError(f"newton = {self.newton!r} must be a ddg.NewtonOptions")
+
+    def check_scene(self, strip: Strip, protocol: LoadingProtocol) -> None:
+        """Refuse a clamp speed the scene cannot use, in physical terms, before any work:
+        faster than the lowest bending wave (2 pi / L) sqrt(EI2 / (rho A)) the clamp outruns the
+        strip (no longer the paper's quasi-static loading, Eq. 7 with the clamp at 1 mm/s); so
+        slow that the march needs more than MAX_TIME_STEPS steps of time_step."""
+        L = strip.length
+        wave = 2.0 * math.pi / L * math.sqrt(strip.bending_stiffness / (strip.density * strip.width * strip.thickness))
+        if self.clamp_speed > wave:
+            raise InputError(f"clamp_speed = {self.clamp_speed:g} m/s outside the allowed range (0, {wave:.3g}] m/s: "
+                             f"faster than the strip's lowest bending wave (paper: 1e-3 m/s)")
+        travel = protocol.compression_ratio * L + protocol.resolved_shear_ratio(strip) * L
+        steps = travel / self.clamp_speed / self.time_step  # inf, not an overflow, for a denormal speed
+        if steps > MAX_TIME_STEPS:
+            slowest = travel / MAX_TIME_STEPS / self.time_step
+            raise InputError(f"clamp_speed = {self.clamp_speed:g} m/s needs {steps:.3g} time steps of {self.time_step:g} s "
+                             f"({travel / self.clamp_speed:.3g} s of loading); allowed up to {MAX_TIME_STEPS:g} "
+                             f"steps, i.e. clamp_speed >= {slowest:.3g} m/s")
+
+
+#: Most implicit-Euler steps a run may plan (a rod step costs ~3 Newton iterations of ~3 ms:
+#: 1e5 steps are ~15 minutes).
+MAX_TIME_STEPS = 1e5
 
 
 class IncrementalPotential:
@@ -267,6 +296,9 @@ def simulate_dynamic(
     if not isinstance(protocol, LoadingProtocol):
         raise InputError(f"protocol = {protocol!r} must be a ddg.LoadingProtocol")
     options = options or DynamicOptions()
+    if not isinstance(options, DynamicOptions):
+        raise InputError(f"options = {options!r} must be a ddg.solve.dynamics.DynamicOptions")
+    options.check_scene(strip, protocol)
     shear_ratio = protocol.resolved_shear_ratio(strip)
     model = RodModel(strip, resolution)
     L = strip.length
@@ -279,6 +311,7 @@ def simulate_dynamic(
     summary = base_summary("rod", strip, protocol, resolution, model)
     summary["solver"] = "implicit-euler"
     summary["scene"]["dynamics"] = dataclasses.asdict(options)
+    folder = open_run_folder(out, summary)
     rows: list[dict] = []
     trace: list[dict] = []
     t0 = time.perf_counter()
@@ -291,9 +324,12 @@ def simulate_dynamic(
         stable = bool(model.free_matrix(ev.hessian).cholesky())
         st = State(q, ev, float(load[0]), float(load[1]), stable, iterations)
         rows.append(observe(model, st, stage, options.eigenvalues))
+        if folder is not None:
+            folder.append(rows[-1])
         trace.append({"time": t, "kinetic_energy": kinetic, "static_residual": scaled_residual(model, ev.gradient)})
         return st
 
+    stage, stopped, interrupted, error, path_complete = "compression", None, None, None, False
     try:
         # the rest state, recorded as the static solver does
         q_rest = model.reset()
@@ -320,25 +356,32 @@ def simulate_dynamic(
             state = record("compression", integrator.q, integrator.load, pending, integrator.kinetic_energy(), integrator.t)
             pending = 0
         summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
+        stage = "shear"
         for target in shears if dW != 0.0 else ():  # as ddg.simulate: no shear rows when dW = 0
             pending = integrator.advance((dL, float(target)), abs(float(target) - integrator.load[1]) / v)
             state = record("shear", integrator.q, integrator.load, pending, integrator.kinetic_energy(), integrator.t)
-        summary["converged"] = True
-        summary["message"] = "path complete"
+        path_complete = True
     except StepFailure as exc:
         c, s = integrator.load
-        summary["message"] = (
+        stopped = (
             f"implicit Euler failed to converge beyond dL/L = {c / L:.6g}, dW/L = {s / L:.6g} "
             f"(t = {integrator.t:.6g} s; time step halved {options.max_halvings} times to {exc.args[0]:.3g} s)"
         )
     except ContinuationFailure as exc:
-        summary["message"] = f"implicit Euler could not start: {exc}"
-    finally:
-        summary["newton_iterations"] = integrator.newton_iterations if integrator is not None else start_iterations
-        summary["wall_time_s"] = time.perf_counter() - t0
-        summary["recorded_steps"] = len(rows)
-        summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
-        result = DynamicResult(rows, summary, state, model, trace=trace)
-        if out is not None:
-            result.write(out)
+        stopped = f"implicit Euler could not start: {exc}"
+    except KeyboardInterrupt as exc:
+        interrupted = exc
+    except Exception as exc:  # noqa: BLE001  (written as status "error", then re-raised)
+        error = exc
+    summary["newton_iterations"] = integrator.newton_iterations if integrator is not None else start_iterations
+    summary["wall_time_s"] = time.perf_counter() - t0
+    finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
+                   stage=stage, error=error)
+    result = DynamicResult(rows, summary, state, model, trace=trace)
+    if folder is not None:
+        folder.finish(result)
+    if interrupted is not None or error is not None:
+        raised = interrupted if interrupted is not None else error
+        raised.result = result
+        raise raised
     return result

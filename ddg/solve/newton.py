@@ -7,9 +7,41 @@ Model interface used here (rod and plate alike): `n_dof`, `free` (slice or indic
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..geometry.strip import InputError
+
+
+def check_option(owner: str, name: str, value, kind: str, low=None, high=None, *, low_open: bool = False,
+                 allow_none: bool = False):
+    """One field of an options object: kind 'int', 'float' or 'bool', within [low, high] (low
+    excluded if low_open); a one-line InputError naming the value and the allowed range."""
+    if value is None and allow_none:
+        return None
+    where = f"{owner}({name}={value!r})"
+    lo = "(" if low_open else "["
+    span = f"{lo}{low:g}, {high:g}]" if low is not None and high is not None else ""
+    if kind == "bool":
+        if not isinstance(value, (bool, np.bool_)):
+            raise InputError(f"{where}: must be True or False")
+        return bool(value)
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise InputError(f"{where}: must be {'an integer' if kind == 'int' else 'a number'} in {span}"
+                         + (" or None" if allow_none else ""))
+    if kind == "int":
+        if isinstance(value, (float, np.floating)) and not float(value).is_integer():
+            raise InputError(f"{where}: must be an integer in {span}")
+        value = int(value)
+    else:
+        value = float(value)
+        if not math.isfinite(value):
+            raise InputError(f"{where}: must be a finite number in {span}")
+    if (low is not None and (value <= low if low_open else value < low)) or (high is not None and value > high):
+        raise InputError(f"{where}: outside the allowed range {span}")
+    return value
 
 
 #: Descending from a saddle to a stable branch (minimize=True) slides along a soft, curved
@@ -17,13 +49,15 @@ import numpy as np
 #: iteration near a pitchfork), so it may take many more iterations than a load step.
 MINIMIZE_ITERATION_FACTOR = 15
 
+#: Iterations with a correction below step_tol after which a residual that has not halved is a stall.
+STALL_ITERATIONS = 3
+
 
 @dataclass
 class NewtonOptions:
     max_iterations: int = 15  # per load step; MINIMIZE_ITERATION_FACTOR times as many when descending from a saddle
     residual_tol: float = 1e-9   # max |dE/dq_i| / (EI2/L^2 or EI2/L), raised to the model's round-off floor
-    step_tol: float = 1e-10      # Newton correction relative to L (positions) or 1 rad (angles)
-    stagnation_residual: float = 1e-3  # the correction test applies only below this residual
+    step_tol: float = 1e-10      # corrections below it (relative to L, or 1 rad) count towards a stall
     max_line_search: int = 30
     # fail fast: a load step whose residual has not fallen below give_up_ratio of its start
     # after give_up_after iterations is outside Newton's basin (converging steps take ~3
@@ -31,6 +65,16 @@ class NewtonOptions:
     # Newton converges only linearly).
     give_up_after: int | None = 4
     give_up_ratio: float = 0.1
+
+    def __post_init__(self) -> None:
+        c = lambda name, *args, **kw: setattr(self, name, check_option("NewtonOptions", name, getattr(self, name),
+                                                                      *args, **kw))  # noqa: E731
+        c("max_iterations", "int", 1, 1000)
+        c("residual_tol", "float", 0.0, 1e-3, low_open=True)
+        c("step_tol", "float", 0.0, 1e-3, low_open=True)
+        c("max_line_search", "int", 1, 60)
+        c("give_up_after", "int", 1, 1000, allow_none=True)
+        c("give_up_ratio", "float", 0.0, 1.0, low_open=True)
 
 
 @dataclass
@@ -68,6 +112,7 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
     ev = evaluation if evaluation is not None else model.evaluate(q)
     pd = None
     shift = 0.0
+    tiny_steps, stall_residual = 0, np.inf
     max_iterations = options.max_iterations * (MINIMIZE_ITERATION_FACTOR if minimize else 1)
     for iteration in range(max_iterations + 1):
         if not np.all(np.isfinite(ev.gradient)):
@@ -89,9 +134,20 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
             use_energy = pd
         dq = -K.solve(r)
         correction = float(np.max(np.abs(dq / lscale)))
-        if correction < options.step_tol and res < options.stagnation_residual and (pd or not minimize):
-            # the Newton correction from q is below tolerance: q is the equilibrium to within it
-            return NewtonResult(q, ev, True, iteration, res, pd)
+        if correction < options.step_tol:
+            # The correction is below tolerance but the residual is not: in a stiff (stretching)
+            # direction a correction of 1e-10 L still leaves a scaled residual of ~0.1, so the step
+            # is taken and convergence is judged by the residual alone. Where corrections stay
+            # this small and the residual stops falling, Newton has stalled: a failure.
+            tiny_steps += 1
+            if tiny_steps >= STALL_ITERATIONS and res > 0.5 * stall_residual:
+                return NewtonResult(q, ev, False, iteration, res, pd,
+                                    f"stalled at scaled residual {res:.3g} (tolerance {residual_tol:.3g}): "
+                                    f"Newton corrections below {options.step_tol:g} for {tiny_steps} iterations")
+            if tiny_steps == 1:
+                stall_residual = res
+        else:
+            tiny_steps = 0
         if iteration == max_iterations:
             break
         slope = float(r @ dq)

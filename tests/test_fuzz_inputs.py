@@ -59,6 +59,18 @@ IN_PROCESS = fuzz_cases.all_in_process_cases()
 RUNS = fuzz_cases.run_cases()
 SUBPROCESS = fuzz_cases.subprocess_cases()
 
+#: The whole file's budget (in-process cases take milliseconds; the subprocesses ~0.2-3 s each).
+FILE_BUDGET_S = 60.0
+_CLOCK = {"start": None, "cases": 0}
+
+
+@pytest.fixture(autouse=True)
+def _count_case():
+    if _CLOCK["start"] is None:
+        _CLOCK["start"] = time.perf_counter()
+    yield
+    _CLOCK["cases"] += 1
+
 
 # ----------------------------------------------------------------------------------- tripwires
 class WorkStarted(BaseException):
@@ -407,3 +419,18 @@ def test_case_counts():
     assert len(bad) >= 300 and len(valid) >= 30 and 5 <= len(RUNS) <= 10 and 10 <= len(SUBPROCESS) <= 13
     assert all(c.expect == RUN for c in RUNS)
     assert len({c.id for c in IN_PROCESS + RUNS + SUBPROCESS}) == len(IN_PROCESS) + len(RUNS) + len(SUBPROCESS)
+
+
+def test_input_error_is_a_one_line_value_error():
+    import ddg
+
+    assert issubclass(ddg.InputError, ValueError)
+
+
+def test_whole_file_within_budget():
+    """Runs last (pytest keeps file order): the file took under FILE_BUDGET_S when every case ran."""
+    total = len(IN_PROCESS) + len(RUNS) + len(SUBPROCESS) + 2  # + test_case_counts, the InputError check
+    if _CLOCK["cases"] < total:
+        pytest.skip(f"only {_CLOCK['cases']} of {total} cases ran")
+    elapsed = time.perf_counter() - _CLOCK["start"]
+    assert elapsed < FILE_BUDGET_S, f"the fuzz file took {elapsed:.1f} s (budget {FILE_BUDGET_S:g} s)"

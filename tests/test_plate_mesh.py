@@ -9,7 +9,7 @@ import pytest
 
 from ddg.energies.hinge_bending import hinge_bending_energy
 from ddg.energies.stretch import stretching_energy
-from ddg.geometry.plate_mesh import mesh_from_arrays, structured_mesh
+from ddg.geometry.plate_mesh import MAX_TRIANGLES, mesh_from_arrays, plate_memory_estimate_bytes, structured_mesh
 from ddg.geometry.strip import InputError
 
 LENGTH = 1.0
@@ -171,8 +171,12 @@ def test_tiny_triangle_count_is_rejected():
             structured_mesh(LENGTH, 0.05, bad)
 
 
-def test_large_mesh_connectivity():
-    """~50k triangles: connectivity is built by sorting, O(N log N) (no timing asserted)."""
+def test_large_mesh_connectivity(monkeypatch):
+    """~50k triangles: connectivity is built by sorting, O(N log N) (no timing asserted). Only
+    the mesh is built: the memory a plate run on it would need (~6 GiB) is not asked for."""
+    import ddg.limits
+
+    monkeypatch.setattr(ddg.limits, "available_memory_bytes", lambda: 1e15)
     width, target = 0.5, 50_000
     mesh = structured_mesh(LENGTH, width, target)
     lo, hi = count_bounds(LENGTH, width, target)
@@ -286,11 +290,64 @@ def _bad_inputs():
         "clamp depth inconsistent": ((nodes, tris, LENGTH, w, 2 * mesh.clamp_depth), "clamp zone"),
         "not flat": ((bumpy, tris, LENGTH, w), "not flat"),
         "degenerate triangle": ((nodes, np.vstack([tris, bottom]), LENGTH, w), "degenerate"),
-        "index too large": ((nodes, np.where(tris == tris.max(), len(nodes), tris), LENGTH, w), "outside"),
-        "negative index": ((nodes, np.where(tris == 0, -1, tris), LENGTH, w), "outside"),
+        "index too large": ((nodes, np.where(tris == tris.max(), len(nodes), tris), LENGTH, w),
+                            f"triangle node index {len(nodes)} out of range 0..{len(nodes) - 1}"),
+        "negative index": ((nodes, np.where(tris == 0, -1, tris), LENGTH, w),
+                           f"triangle node index -1 out of range 0..{len(nodes) - 1}"),
         "float indices": ((nodes, tris.astype(float), LENGTH, w), "integer"),
         "nodes shape": ((np.c_[nodes, nodes], tris, LENGTH, w), "shape"),
         "triangles shape": ((nodes, tris[:, :2], LENGTH, w), "shape"),
+    } | _defective_meshes(mesh)
+
+
+def _defective_meshes(mesh):
+    """Issue 13 item 4: every defect of a mesh given as arrays, with the reason expected."""
+    nodes, tris, w, c = mesh.nodes, mesh.triangles, mesh.width, mesh.clamp_depth
+    n = len(nodes)
+    centroid = nodes[tris].mean(axis=1)
+    # an unmerged cut along a node column: the triangles right of it use copies of its nodes
+    column = np.unique(np.round(nodes[:, 0], 12))[5]
+    on = np.flatnonzero(np.abs(nodes[:, 0] - column) < 1e-12)
+    relabel = np.arange(n)
+    relabel[on] = n + np.arange(len(on))
+    unmerged = np.where((centroid[:, 0] > column)[:, None], relabel[tris], tris)
+    soup = nodes[tris].reshape(-1, 2)
+    hole = np.linalg.norm(centroid - [0.5 * LENGTH, 0.0], axis=1) < 0.3 * w
+    hinge = mesh.hinges[len(mesh.hinges) // 2]
+    folded = nodes.copy()
+    folded[np.argmin(np.linalg.norm(nodes - [0.5 * LENGTH, 0.0], axis=1)), 0] += 3 * c
+    on_bottom = np.sum(np.abs(nodes[tris, 1] + 0.5 * w) < 1e-12, axis=1) == 2
+    notch = np.flatnonzero(on_bottom & (np.abs(centroid[:, 0] - 0.5 * LENGTH) < 2 * c))[0]
+    non_finite = nodes.copy()
+    non_finite[3] = [np.nan, np.inf]
+    return {
+        "triangle soup": ((soup, np.arange(len(soup)).reshape(-1, 3), LENGTH, w),
+                          f"triangle soup: its {len(tris)} triangles share no nodes or edges"),
+        "duplicate nodes": ((np.vstack([nodes, nodes[on]]), unmerged, LENGTH, w),
+                            f"has {len(on)} duplicate nodes (e.g. at ("),
+        "duplicate triangle": ((nodes, np.vstack([tris, tris[-1:]]), LENGTH, w), "has 1 duplicate triangle (e.g."),
+        "hole": ((nodes, tris[~hole], LENGTH, w), "has a hole (2 boundary loops"),
+        "two pieces": ((np.vstack([nodes, nodes + [0.0, 2 * w]]), np.vstack([tris, tris + n]), LENGTH, w),
+                       "has 2 disconnected pieces"),
+        "non-manifold edge": ((np.vstack([nodes, nodes[hinge[[0, 1, 2]]].mean(axis=0)]),
+                               np.vstack([tris, [hinge[0], hinge[1], n]]), LENGTH, w),
+                              "is not a manifold: 1 edge shared by more than two triangles"),
+        "folded": ((folded, tris, LENGTH, w), "overlapping (folded or inverted) triangles"),
+        "notched outline": ((nodes, np.delete(tris, notch, axis=0), LENGTH, w), "outline is not a rectangle"),
+        "non-finite": ((non_finite, tris, LENGTH, w), "has 1 node with non-finite coordinates (e.g. node 3"),
+        "complex nodes": ((nodes.astype(complex), tris, LENGTH, w), "dtype complex128"),
+        "text nodes": ((nodes.astype(str), tris, LENGTH, w), "expected real coordinates"),
+        "ragged nodes": (([[0.0, 1.0], [1.0]], tris, LENGTH, w), "array of real coordinates"),
+        "bool triangles": ((nodes, tris > 0, LENGTH, w), "integer node indices, not bool"),
+        "no triangles": ((nodes, np.zeros((0, 3), dtype=int), LENGTH, w), "has no triangles"),
+        "no nodes": ((np.zeros((0, 2)), tris, LENGTH, w), "has no nodes"),
+        "unused node refused": ((np.vstack([nodes, [0.5 * LENGTH, 0.01]]), tris, LENGTH, w),
+                                f"has 1 node used by no triangle (e.g. node {n}", {"allow_unused_nodes": False}),
+        "stretched 1.5x": ((nodes * [1.5, 1.0], tris, LENGTH, w),
+                           f"is {1.5 * (LENGTH + 2 * c):.6g} m long but the strip needs L + 2c = "
+                           f"{LENGTH + 3 * c:.6g} m"),
+        "shorter than L": ((nodes * [0.8, 1.0], tris, LENGTH, w), f"L = {LENGTH:.6g} m between the clamp lines"),
+        "bad length": ((nodes, tris, -1.0, w), "length = -1.0"),
     }
 
 
@@ -299,9 +356,9 @@ BAD_INPUTS = _bad_inputs()
 
 @pytest.mark.parametrize("case", sorted(BAD_INPUTS))
 def test_mesh_from_arrays_rejects_bad_input(case):
-    args, keyword = BAD_INPUTS[case]
+    args, keyword, *options = BAD_INPUTS[case]
     nodes, tris, length, width, *depth = args
-    kwargs = {"clamp_depth": depth[0]} if depth else {}
+    kwargs = ({"clamp_depth": depth[0]} if depth else {}) | (options[0] if options else {})
     with pytest.raises(InputError) as info:
         mesh_from_arrays(nodes, tris, length, width, **kwargs)
     message = str(info.value)
@@ -331,3 +388,94 @@ def test_locate_rejects_points_outside(point):
     mesh = structured_mesh(LENGTH, 0.2, 800)
     with pytest.raises(InputError, match="outside the mesh"):
         mesh.locate([[0.5, 0.0], point])
+
+
+# --------------------------------------------------------------------------- clamp zone of a mesh given without one
+def jittered_ends(seed: int = 3):
+    """A structured mesh whose second node column at each end is jittered in x by up to 0.2 c:
+    the first layer of triangles at each end is between 1.8 c and 2.2 c deep."""
+    mesh = structured_mesh(LENGTH, 0.25, 200)
+    nodes = mesh.nodes.copy()
+    rng = np.random.default_rng(seed)
+    c = mesh.clamp_depth
+    for x in (c, LENGTH - c):
+        column = np.abs(nodes[:, 0] - x) < 1e-12
+        nodes[column, 0] += 0.2 * c * rng.uniform(-1, 1, column.sum())
+    return mesh, nodes
+
+
+def test_clamp_zone_of_unstructured_ends_is_the_first_layer():
+    """2c may lie anywhere within the first layer of triangles at each end (from the shallowest
+    to the deepest triangle touching the end): accepted at 2c = 2 c_0; a mesh 5 % too long or 2 %
+    too short is refused, stating the window of lengths it would need."""
+    mesh, nodes = jittered_ends()
+    copy = mesh_from_arrays(nodes, mesh.triangles, LENGTH, 0.25)
+    assert copy.clamp_depth == pytest.approx(mesh.clamp_depth, rel=1e-9)
+    assert copy.clamped_left.sum() >= mesh.width / (2 * mesh.clamp_depth)  # at least the end column
+    for factor in (1.05, 0.98):
+        with pytest.raises(InputError) as info:
+            mesh_from_arrays(nodes * [factor, 1.0], mesh.triangles, LENGTH, 0.25)
+        message = str(info.value)
+        assert "L + 2c between" in message and "first layer of triangles" in message and "\n" not in message
+
+
+def test_clamp_zone_must_match_at_both_ends():
+    """A structured mesh whose last column spacing is doubled: first layers of 2c and 4c."""
+    mesh = structured_mesh(LENGTH, 0.25, 200)
+    nodes = mesh.nodes.copy()
+    right = nodes[:, 0] > LENGTH
+    nodes[right, 0] += 2 * mesh.clamp_depth
+    with pytest.raises(InputError, match="first layers of triangles of different depths at its two ends"):
+        mesh_from_arrays(nodes, mesh.triangles, LENGTH, 0.25)
+
+
+def test_file_round_off_keeps_the_clamped_nodes():
+    """A single-precision copy of a 75 mm strip 3 m off the origin, as a float32 file holds it:
+    good to ~1.2e-7 m there, more than 1e-6 L = 7.5e-8 m (as float64 it is refused: its width is
+    off by 2e-7 m). The file's round-off is allowed for and the same nodes are clamped."""
+    length, width = 0.075, 0.0125
+    mesh = structured_mesh(length, width, 200)
+    single = (mesh.nodes + [3.0, 3.0]).astype(np.float32)
+    with pytest.raises(InputError, match="width"):
+        mesh_from_arrays(single.astype(np.float64), mesh.triangles, length, width)
+    copy = mesh_from_arrays(single, mesh.triangles, length, width)
+    assert copy.clamped_left.sum() == mesh.clamped_left.sum()
+    assert copy.clamped_right.sum() == mesh.clamped_right.sum()
+    assert copy.clamp_depth == pytest.approx(mesh.clamp_depth, rel=1e-3)
+
+
+# --------------------------------------------------------------------------- sizes
+def test_triangle_count_has_a_hard_cap():
+    with pytest.raises(InputError) as info:
+        structured_mesh(LENGTH, 0.05, MAX_TRIANGLES + 1)
+    message = str(info.value)
+    assert f"triangles = {MAX_TRIANGLES + 1} outside the allowed range [16, {MAX_TRIANGLES}]" in message
+    assert "\n" not in message
+
+
+def test_structured_mesh_refuses_a_size_beyond_the_memory(monkeypatch):
+    """Refused from the estimate, before the mesh is built."""
+    import ddg.limits
+
+    monkeypatch.setattr(ddg.limits, "available_memory_bytes", lambda: 64 * 2.0**20)  # 32 MiB for a run
+    structured_mesh(LENGTH, 0.05, 500)
+    estimate = plate_memory_estimate_bytes(LENGTH, 0.05, 4000)
+    with pytest.raises(InputError) as info:
+        structured_mesh(LENGTH, 0.05, 4000)
+    assert str(info.value) == (f"triangles = 4000 needs about {estimate / 2**30:.3g} GiB; this machine allows "
+                               f"{32 / 1024:.3g} GiB for a run (50 % of the memory available)")
+
+
+@pytest.mark.parametrize("width", WIDTHS)
+def test_memory_estimate_from_the_size_matches_the_mesh(width):
+    """The estimate from (L, W, triangles) is the one from the structured mesh's actual node
+    count and band (to 10 %), and it grows as triangles^1.5 (the band as sqrt(triangles))."""
+    estimates = []
+    for target in (2000, 8000):
+        mesh = structured_mesh(LENGTH, width, target)
+        actual = plate_memory_estimate_bytes(LENGTH, width, mesh.triangle_count, nodes=mesh.node_count,
+                                             bandwidth_nodes=mesh.bandwidth_nodes())
+        estimates.append(plate_memory_estimate_bytes(LENGTH, width, target))
+        assert estimates[-1] == pytest.approx(actual, rel=0.1)
+    assert 4.0 < estimates[1] / estimates[0] < 4.0**1.5 * 1.1
+    assert plate_memory_estimate_bytes(LENGTH, width, 2000, unstructured=True) > estimates[0]

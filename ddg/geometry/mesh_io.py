@@ -4,6 +4,10 @@ Both return a `PlateMesh` in the convention of `plate_mesh`: the mesh covers
 [-c, L + c] x [-W/2, W/2] and the nodes in the band [-c, c] around the clamp line x = 0
 (and [L - c, L + c] around x = L) move rigidly with the fixed (moving) clamp; the rigid
 triangles straddle the clamp lines, so the free plate between them is exactly L long.
+A file gives no c: the band at each end is the mesh's first layer of triangles, 2c deep, and
+the mesh must be L + 2c long (plate_mesh.mesh_from_arrays), so a mesh of the wrong length is
+refused rather than clamped deeper. Sizes are bounded by MAX_TRIANGLES and by the memory a
+plate run needs (plate_mesh.plate_memory_estimate_bytes).
 meshio and gmsh are optional (Debian python3-meshio, python3-gmsh) and imported lazily.
 """
 from __future__ import annotations
@@ -11,14 +15,21 @@ from __future__ import annotations
 import contextlib
 import io
 import math
+import os
 import signal
 import threading
 from pathlib import Path
 
 import numpy as np
 
-from .plate_mesh import DEFAULT_TRIANGLES, PlateMesh, mesh_from_arrays
+from ..limits import check_integer
+from .plate_mesh import (DEFAULT_TRIANGLES, MAX_TRIANGLES, PlateMesh, check_mesh_memory, check_plate_size,
+                         mesh_from_arrays)
 from .strip import InputError
+
+#: Cells a mesh file may hold besides its triangles (gmsh's boundary lines and corner points);
+#: any other cell (quads, quadratic triangles, polygons, volumes) would be silently dropped.
+_IGNORED_CELLS = frozenset({"vertex", "line", "line3"})
 
 #: Frontal-Delaunay: near-equilateral triangles (minimum angle ~40 degrees at 2000 triangles).
 _GMSH_ALGORITHM = 6
@@ -47,18 +58,35 @@ def _import_meshio():
     return meshio
 
 
+def _in_file(path: Path, error: InputError) -> InputError:
+    """The error of mesh_from_arrays ("mesh has ...") as one naming the file ("mesh file 'x' has ...")."""
+    text = str(error)
+    if text.startswith("mesh "):
+        return InputError(f"mesh file {str(path)!r} {text[len('mesh '):]}")
+    return InputError(f"mesh file {str(path)!r}: {text}")
+
+
 def read_mesh(path, length: float, width: float) -> PlateMesh:
     """Read a flat triangle mesh of the strip from any format meshio reads (.msh, .vtu, .obj, ...).
 
-    The mesh must span the width W and L + 2c along x (any offset): the nodes within 2c of
-    each end (the band [-c, c] around each clamp line) are clamped. Only the "triangle" cells are used
-    (lines and vertices, e.g. gmsh's boundary elements, are ignored); z must be constant.
+    The mesh must be one flat piece of linear triangles covering the rectangle L + 2c by W
+    (any offset), its clamp zone at each end being its first layer of triangles, 2c deep: the
+    nodes within 2c of each end (the band [-c, c] around each clamp line) are clamped. Cells
+    other than triangles may only be boundary lines and points (ignored, as gmsh writes them);
+    z must be constant; every node must belong to a triangle. Every defect (see
+    mesh_from_arrays) and a size beyond MAX_TRIANGLES or the machine's memory raises a one-line
+    InputError naming the file, before any work.
     """
     _check_lengths(length, width)
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError(f"mesh = {path!r} must be the path of a mesh file (str or os.PathLike), "
+                         f"not {type(path).__name__}")
     meshio = _import_meshio()
     path = Path(path)
     if not path.is_file():
         raise InputError(f"mesh file {str(path)!r} does not exist or is not a file")
+    if path.stat().st_size == 0:
+        raise InputError(f"mesh file {str(path)!r} is empty (0 bytes)")
     # meshio prints each failed format attempt and calls sys.exit(1) when none reads the file,
     # so its output is captured and SystemExit turned into our error
     chatter = io.StringIO()
@@ -71,6 +99,8 @@ def read_mesh(path, length: float, width: float) -> PlateMesh:
         if not reason:
             reason = next((line.strip() for line in chatter.getvalue().splitlines() if line.strip()),
                           "not a mesh format meshio can read").removeprefix("Error:").strip()
+        if "need at least one array to concatenate" in reason:  # meshio's VTU reader on a file without cells
+            reason = "it holds no cells (an empty mesh?)"
         raise InputError(f"cannot read mesh file {str(path)!r}: {reason}") from None
     blocks = [np.asarray(block.data) for block in data.cells if block.type == "triangle"]
     if not blocks:
@@ -79,10 +109,21 @@ def read_mesh(path, length: float, width: float) -> PlateMesh:
             f"mesh file {str(path)!r} has no triangle cells (found: {', '.join(found)}); "
             "give a linear triangle mesh of the strip"
         )
+    others = sorted({block.type for block in data.cells} - _IGNORED_CELLS - {"triangle"})
+    if others:
+        raise InputError(f"mesh file {str(path)!r} has {', '.join(others)} cells besides its triangles; "
+                         "give a mesh of linear triangles only (those cells would be ignored)")
+    count = sum(len(block) for block in blocks)
     try:
-        return mesh_from_arrays(data.points, np.concatenate(blocks), length, width)
+        check_integer("triangles", count, 1, MAX_TRIANGLES, "a plate run of more would not fit in memory")
     except InputError as error:
         raise InputError(f"mesh file {str(path)!r}: {error}") from None
+    try:
+        mesh = mesh_from_arrays(data.points, np.concatenate(blocks), length, width, allow_unused_nodes=False)
+        check_mesh_memory(mesh)
+    except InputError as error:
+        raise _in_file(path, error) from None
+    return mesh
 
 
 def _gmsh_initialized(gmsh) -> bool:
@@ -107,10 +148,14 @@ def gmsh_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANGLES,
     height of an equilateral triangle, sqrt(3)/4 h, so that, as on the structured mesh (half a
     column spacing), each band is one layer of rigid triangles straddling its clamp line. Deterministic (fixed seed, one thread, no
     config files); gmsh is initialised only if it is not already, and left as it was found.
+    `triangles` is an integer in [16, MAX_TRIANGLES] whose plate run fits in memory
+    (plate_mesh.check_plate_size), checked before gmsh is called. Note: a clamp_depth of more
+    than one layer makes the clamped bands several layers deep; the last rigid layer then
+    clamps the slope at about c - h/2, so the free plate is about L - 2c + h long, not L (and
+    read_mesh, which takes the first layer as the clamp zone, refuses such a mesh in a file).
     """
     _check_lengths(length, width)
-    if not (isinstance(triangles, (int, np.integer)) and not isinstance(triangles, bool) and triangles >= 16):
-        raise InputError(f"triangles = {triangles!r} must be an integer >= 16 (the paper uses ~2000)")
+    triangles = check_plate_size(length, width, triangles, unstructured=True)
     if clamp_depth is not None and not (
         isinstance(clamp_depth, (int, float, np.floating)) and math.isfinite(clamp_depth)
         and 0 < clamp_depth < 0.5 * length
@@ -167,7 +212,9 @@ def gmsh_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANGLES,
                 gmsh.model.setCurrent(previous_model)
         if main_thread and sigint is not None:
             signal.signal(signal.SIGINT, sigint)
-    return mesh_from_arrays(nodes, tris, length, width, clamp_depth=c)
+    mesh = mesh_from_arrays(nodes, tris, length, width, clamp_depth=c)
+    check_mesh_memory(mesh)  # the estimate above took the band of a typical unstructured mesh
+    return mesh
 
 
 def _count_between_clamps(nodes: np.ndarray, tris: np.ndarray, length: float) -> int:

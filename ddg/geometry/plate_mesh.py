@@ -10,6 +10,12 @@ slope, and a triangle's normal is the slope at the middle of its chord, x = 0. T
 between the clamp lines is then exactly L, and the clamped elastica converges as O(h^2).
 (Clamping the columns at x = -h and 0 instead puts the clamped slope at x = -h/2, lengthens
 the plate by one spacing and biases H_mid by O(h): +0.84 % at the default mesh, measured.)
+A mesh given without c (a file) is held to the same convention: its clamp zone at each end is
+its first layer of triangles, 2c deep, and it must be L + 2c long to round-off.
+
+Meshes are validated (mesh_from_arrays: one flat disc covering the rectangle, no duplicate
+nodes, holes, folds...) and sized (MAX_TRIANGLES, plate_memory_estimate_bytes) with one-line
+InputErrors before any work.
 
 Nodes are ordered by x (then y): clamped-left nodes first, clamped-right last, and the
 Hessian has a narrow band (about six times the nodes per column) for a strip.
@@ -23,6 +29,7 @@ from functools import cached_property
 
 import numpy as np
 
+from ..limits import check_integer, check_memory
 from .strip import InputError
 
 #: Default target triangle count, as in the paper (N_mesh ~ 2000).
@@ -35,7 +42,9 @@ class PlateMesh:
 
     nodes (N, 2) reference positions, triangles (T, 3) node indices, counter-clockwise
     (normals +z in the flat state), length L between the clamp lines x = 0 and x = L,
-    width W, clamp_depth c. Build with `mesh_from_arrays` (validates and orders).
+    width W, clamp_depth c; clamp_tolerance: how far (m) beyond x = c (x = L - c) a node still
+    counts as clamped (at least 1e-9 L; a file's round-off, see coordinate_tolerance).
+    Build with `mesh_from_arrays` (validates and orders).
     """
 
     nodes: np.ndarray
@@ -43,6 +52,7 @@ class PlateMesh:
     length: float
     width: float
     clamp_depth: float
+    clamp_tolerance: float = 0.0
 
     # ------------------------------------------------------------------ counts
     @property
@@ -76,7 +86,7 @@ class PlateMesh:
 
     @property
     def _clamp_tolerance(self) -> float:
-        return 1e-9 * self.length
+        return max(1e-9 * self.length, self.clamp_tolerance)
 
     # ------------------------------------------------------------------ connectivity
     @cached_property
@@ -185,60 +195,327 @@ class PlateMesh:
                 "hinges": len(self.hinges), "clamp_depth": self.clamp_depth}
 
 
-def mesh_from_arrays(nodes, triangles, length: float, width: float, *, clamp_depth: float | None = None) -> PlateMesh:
-    """Validate a flat triangle mesh of [x0, x1] x [-W/2, W/2] and bring it to our convention.
+#: Hard cap on the triangles of a plate mesh: a 1e6-triangle strip already needs tens of GiB
+#: for its banded Hessian (plate_memory_estimate_bytes), and the paper uses ~2000.
+MAX_TRIANGLES = 1_000_000
 
-    The mesh must span the width W and a length L + 2c (c > 0; nodes within 2c of each end,
-    i.e. in the band [-c, c] around a clamp line, are clamped); it is shifted so the clamp
-    lines sit at x = 0 and x = L, triangles are made counter-clockwise, unused nodes dropped
-    and nodes ordered by x.
+#: Band storages (each (3 b + 3) x 3N doubles for b = bandwidth_nodes) alive at once during a
+#: run, measured (14, by tracking every SymmetricBanded on a complete 500-triangle path with its
+#: thresholds) and rounded up: the current state's Hessian, its free block and Cholesky factor,
+#: the same for the state being solved and for the snapshots the thresholds restart from
+#: (compressed, last U, last US, first S), a shifted copy and its factor when the Hessian is
+#: indefinite, and the LU fallback (its (2u+1)-row copy and LAPACK's (3u+1)-row work array).
+RUN_BAND_COPIES = 16
+
+#: Bytes per triangle besides the bands, measured with tracemalloc: 3.5 kB kept by the model
+#: (edges, hinges, rest lengths, stiffnesses, the assembler's scatter indices) and 5.6 kB of
+#: element blocks while a Hessian is assembled; rounded up.
+RUN_BYTES_PER_TRIANGLE = 10_000
+
+#: x-ordered unstructured (gmsh) meshes have a wider band than the structured mesh of the same
+#: size: 1.26x to 1.43x measured at W/L = 1/20, 1/6, 1/2 (2000 and 8000 triangles).
+UNSTRUCTURED_BAND_FACTOR = 1.5
+
+
+def _structured_size(length: float, width: float, triangles: int) -> tuple[int, int]:
+    """(n, n_y) of the structured mesh with about `triangles` triangles in [0, L] (see structured_mesh)."""
+    # 2 n n_y triangles in [0, L] with h_x = sqrt(3)/2 h_y
+    h_y = math.sqrt(2.0 * length * width / (0.5 * math.sqrt(3.0) * triangles))
+    n_y = _round_even(width / h_y, 2)
+    n = max(3, 2 * int(0.5 * length / (0.5 * math.sqrt(3.0) * width / n_y)) + 1)  # nearest odd
+    return n, n_y
+
+
+def plate_memory_estimate_bytes(length: float, width: float, triangles: int, *, nodes: int | None = None,
+                                bandwidth_nodes: int | None = None, unstructured: bool = False) -> float:
+    """Estimated peak memory (bytes) of a plate run on a mesh of the L x W strip.
+
+    Without `nodes` and `bandwidth_nodes` they are those of the structured mesh for a target of
+    `triangles` (structured_mesh's construction: n + 2 columns of about n_y + 1.5 nodes, a
+    hinge spanning two columns, bandwidth ~ 2 (n_y + 2) nodes), widened by
+    UNSTRUCTURED_BAND_FACTOR for an unstructured (gmsh) mesh; give them for an actual mesh
+    (a file: its node count and PlateMesh.bandwidth_nodes()). The run holds RUN_BAND_COPIES
+    banded matrices of 3N columns and 3 b + 3 rows (ddg.solve.banded; the plate's bandwidth
+    is 3 b + 2) and RUN_BYTES_PER_TRIANGLE per triangle; a few MB of fixed overheads (recorded
+    rows, eigensolver work) are left out (a complete 504-triangle path: 13 MB estimated, 20 MB
+    peak traced), so it is meant for the large sizes the machine cannot run, where the bands
+    dominate (ddg.limits.check_memory refuses them).
     """
-    nodes = np.asarray(nodes, dtype=float)
-    triangles = np.asarray(triangles)
+    if nodes is None or bandwidth_nodes is None:
+        n, n_y = _structured_size(length, width, triangles)
+        nodes = (n + 2) * (n_y + 1.5) if nodes is None else nodes
+        if bandwidth_nodes is None:
+            bandwidth_nodes = 2 * (n_y + 2) * (UNSTRUCTURED_BAND_FACTOR if unstructured else 1.0)
+        triangles = max(triangles, (n + 1) * (2 * n_y + 1))
+    band_bytes = 8.0 * (3.0 * bandwidth_nodes + 3.0) * 3.0 * nodes
+    return RUN_BAND_COPIES * band_bytes + RUN_BYTES_PER_TRIANGLE * float(triangles)
+
+
+def check_plate_size(length: float, width: float, triangles, *, unstructured: bool = False) -> int:
+    """The target triangle count as an int in [16, MAX_TRIANGLES] whose run fits in memory
+    (InputError otherwise, one line, before any mesh is built)."""
+    if not (isinstance(triangles, (int, np.integer)) and not isinstance(triangles, bool) and triangles >= 16):
+        raise InputError(f"triangles = {triangles!r} must be an integer >= 16 (the paper uses ~2000)")
+    triangles = check_integer("triangles", triangles, 16, MAX_TRIANGLES,
+                              "the plate's banded Hessian grows as triangles^1.5 (the paper uses ~2000)")
+    check_memory("triangles", triangles,
+                 plate_memory_estimate_bytes(length, width, triangles, unstructured=unstructured))
+    return triangles
+
+
+def check_mesh_memory(mesh: "PlateMesh") -> None:
+    """Refuse a mesh whose plate run would not fit in memory (its actual size and band)."""
+    band = mesh.bandwidth_nodes()
+    estimate = plate_memory_estimate_bytes(mesh.length, mesh.width, mesh.triangle_count, nodes=mesh.node_count,
+                                           bandwidth_nodes=band)
+    check_memory("triangles", f"{mesh.triangle_count} ({mesh.node_count} nodes, a Hessian band of {band} nodes)",
+                 estimate)
+
+
+def coordinate_tolerance(length: float, coordinates: np.ndarray, dtype=np.float64) -> float:
+    """Distance (m) below which two mesh positions or lengths count as equal.
+
+    1e-6 L: below it nothing physical changes (a strip 1e-6 L too long moves H_mid by ~1e-6
+    relative) and it is far below any mesh spacing the size cap allows (h > 1e-4 L at 1e6
+    triangles), so distinct nodes are never merged; it is far above double round-off. Plus
+    16 units in the last place of the largest coordinate in the file's precision: a file in
+    single precision (eps 1.2e-7) at an offset of metres is good to only ~1e-7 m.
+    """
+    eps = np.finfo(dtype).eps if np.issubdtype(dtype, np.floating) else 0.0
+    magnitude = float(np.max(np.abs(coordinates))) if coordinates.size else 0.0
+    return 1e-6 * length + 16.0 * eps * magnitude
+
+
+def _count(number: int, noun: str) -> str:
+    return f"{number} {noun}{'' if number == 1 else 's'}"
+
+
+def _at(point) -> str:
+    return "(" + ", ".join(f"{v:.6g}" for v in point) + ")"
+
+
+def _check_numbers(nodes, triangles):
+    """Shape, dtype, index range and finiteness: (nodes (N, 2 or 3) float, triangles int64, dtype)."""
+    try:
+        raw = np.asarray(nodes)
+    except (TypeError, ValueError):  # ragged nested lists
+        raise InputError("mesh nodes must be an (N, 2) or (N, 3) array of real coordinates") from None
+    if raw.dtype.kind not in "iuf":  # complex, text, objects, booleans
+        raise InputError(f"mesh nodes have dtype {raw.dtype}; expected real coordinates")
+    dtype, nodes = raw.dtype, raw.astype(float)
     if nodes.ndim != 2 or nodes.shape[1] not in (2, 3):
         raise InputError(f"mesh nodes have shape {nodes.shape}; expected (N, 2) or (N, 3)")
-    if nodes.shape[1] == 3:
-        if np.ptp(nodes[:, 2]) > 1e-9 * max(np.ptp(nodes[:, 0]), 1e-300):
-            raise InputError("mesh is not flat: its z coordinates vary; give the flat reference strip")
-        nodes = nodes[:, :2]
-    if triangles.ndim != 2 or triangles.shape[1] != 3 or len(triangles) == 0:
-        raise InputError(f"mesh triangles have shape {triangles.shape}; expected (T, 3) with T > 0")
+    if len(nodes) == 0:
+        raise InputError("mesh has no nodes")
+    try:
+        triangles = np.asarray(triangles)
+    except (TypeError, ValueError):
+        raise InputError("mesh triangles must be a (T, 3) array of integer node indices") from None
+    if triangles.ndim != 2 or triangles.shape[1] != 3:
+        raise InputError(f"mesh triangles have shape {triangles.shape}; expected (T, 3)")
+    if len(triangles) == 0:
+        raise InputError("mesh has no triangles")
     if not np.issubdtype(triangles.dtype, np.integer):
-        raise InputError("mesh triangles must be integer node indices")
-    if triangles.min() < 0 or triangles.max() >= len(nodes):
-        raise InputError(f"mesh triangles index nodes outside 0..{len(nodes) - 1}")
-    if not np.all(np.isfinite(nodes)):
-        raise InputError("mesh nodes contain non-finite coordinates")
+        raise InputError(f"mesh triangles must be integer node indices, not {triangles.dtype}")
+    bad = (triangles < 0) | (triangles >= len(nodes))
+    if np.any(bad):
+        count = int(bad.sum())
+        raise InputError(f"mesh has triangle node index {triangles[bad][0]} out of range 0..{len(nodes) - 1} "
+                         f"({count} such {'index' if count == 1 else 'indices'})")
+    finite = np.all(np.isfinite(nodes), axis=1)
+    if not np.all(finite):
+        k = int(np.argmin(finite))
+        raise InputError(f"mesh has {_count(int((~finite).sum()), 'node')} with non-finite coordinates "
+                         f"(e.g. node {k}: {_at(nodes[k])})")
+    return nodes, triangles.astype(np.int64), dtype
+
+
+def _check_flat(nodes: np.ndarray, tol: float) -> np.ndarray:
+    if nodes.shape[1] == 3:
+        spread = float(np.ptp(nodes[:, 2]))
+        if spread > tol:
+            raise InputError(f"mesh is not flat: its z coordinates vary by {spread:.3g} m (allowed {tol:.2g} m); "
+                             "give the flat reference strip in the x-y plane")
+        nodes = nodes[:, :2]
+    return nodes
+
+
+def _check_shared_nodes(nodes: np.ndarray, triangles: np.ndarray, tol: float) -> None:
+    """A triangle soup (no node shared) and coincident (unmerged) nodes."""
+    if len(triangles) > 1 and len(nodes) == 3 * len(triangles):
+        raise InputError(f"mesh is a triangle soup: its {len(triangles)} triangles share no nodes or edges (each has "
+                         "its own 3 nodes, as from an unmerged export); merge coincident nodes")
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(nodes).query_pairs(tol, output_type="ndarray")
+    if len(pairs):
+        count = len(np.unique(pairs.max(axis=1)))  # all but one node of each cluster
+        raise InputError(f"mesh has {_count(count, 'duplicate node')} (e.g. at {_at(nodes[pairs[0, 0]])}, "
+                         f"within {tol:.2g} m); merge them")
+
+
+def _signed_areas(nodes: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    p = nodes[triangles]
+    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    return 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
+
+
+def _check_disc(nodes: np.ndarray, triangles: np.ndarray, areas: np.ndarray, tol: float) -> None:
+    """The counter-clockwise triangles must form one flat disc covering the bounding rectangle:
+    no repeated triangle, no edge of more than two triangles, no overlap (fold), one piece,
+    no pinched node, no hole, a rectangular outline."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n, t = len(nodes), triangles
+    rows, repeats = np.unique(np.sort(t, axis=1), axis=0, return_counts=True)
+    if np.any(repeats > 1):
+        example = rows[np.argmax(repeats > 1)]
+        raise InputError(f"mesh has {_count(int((repeats - 1).sum()), 'duplicate triangle')} (e.g. the one with "
+                         f"corners {', '.join(_at(nodes[k]) for k in example)}); remove them")
+    start, end = t.ravel(), t[:, [1, 2, 0]].ravel()
+    lo, hi = np.minimum(start, end), np.maximum(start, end)
+    key = lo * n + hi
+    edges, counts = np.unique(key, return_counts=True)
+    if np.any(counts > 2):
+        a, b = divmod(int(edges[np.argmax(counts > 2)]), n)
+        raise InputError(f"mesh is not a manifold: {_count(int((counts > 2).sum()), 'edge')} shared by more than two "
+                         f"triangles (e.g. the edge from {_at(nodes[a])} to {_at(nodes[b])})")
+    # a shared edge runs once each way around its two counter-clockwise triangles; twice the same
+    # way means both lie on the same side of it: they overlap (a fold or an inverted triangle)
+    directed, dcounts = np.unique(start * n + end, return_counts=True)
+    if np.any(dcounts > 1):
+        a, b = divmod(int(directed[np.argmax(dcounts > 1)]), n)
+        raise InputError(f"mesh has overlapping (folded or inverted) triangles: the two triangles at the edge from "
+                         f"{_at(nodes[a])} to {_at(nodes[b])} lie on the same side of it")
+    order = np.argsort(key, kind="stable")
+    shared = key[order[1:]] == key[order[:-1]]
+    tri_a, tri_b = order[:-1][shared] // 3, order[1:][shared] // 3
+    graph = coo_matrix((np.ones(len(tri_a)), (tri_a, tri_b)), shape=(len(t), len(t)))
+    pieces, labels = connected_components(graph, directed=False)
+    if pieces > 1:
+        largest = int(np.bincount(labels).max())
+        raise InputError(f"mesh has {pieces} disconnected pieces (triangles joined by no shared edge; the largest "
+                         f"has {largest} of {len(t)} triangles); the strip must be one piece")
+    boundary = np.stack(divmod(edges[counts == 1], n), axis=1)
+    degree = np.bincount(boundary.ravel(), minlength=n)
+    if np.any(degree > 2):
+        raise InputError(f"mesh is not a manifold at the node {_at(nodes[int(np.argmax(degree > 2))])}: "
+                         "pieces of it meet only at that node")
+    on_boundary = np.flatnonzero(degree)
+    loop_graph = coo_matrix((np.ones(len(boundary)), (boundary[:, 0], boundary[:, 1])), shape=(n, n))
+    loops = connected_components(loop_graph, directed=False)[0] - (n - len(on_boundary))
+    euler = n - len(edges) + len(t)
+    if loops != 1 or euler != 1:
+        raise InputError(f"mesh has a hole ({max(loops, 2 - euler)} boundary loops, Euler characteristic "
+                         f"V - E + F = {euler}; the strip must be simply connected)")
+    # a disc covering less than its bounding rectangle has a notched outline; the tolerance is
+    # the area of a band `tol` wide along the perimeter (boundary nodes off the sides by round-off)
+    span = np.ptp(nodes, axis=0)
+    rectangle, covered = float(span[0] * span[1]), float(np.abs(areas).sum())
+    if abs(covered - rectangle) > 2.0 * tol * float(span.sum()):
+        raise InputError(f"mesh covers {covered:.6g} m^2 but the rectangle it spans, {span[0]:.6g} x {span[1]:.6g} m, "
+                         f"is {rectangle:.6g} m^2: its outline is not a rectangle (a notch or a cut corner?)")
+
+
+def _inferred_clamp_depth(x: np.ndarray, triangles: np.ndarray, length: float, tol: float) -> float:
+    """Clamp depth c of a mesh given without one: the mesh spans L + 2c, and the clamped band
+    [-c, c] around each clamp line (2c deep, from the end of the mesh) holds the mesh's first
+    layer of triangles, as on the structured and gmsh meshes (one layer of rigid triangles
+    centred on the clamp line; a deeper band would move the clamp inward and shorten the free
+    plate). So 2c must lie between the shallowest and the deepest triangle touching each end:
+    exactly the layer's depth, to `tol`, when the ends are one structured layer."""
+    x0, x1 = float(x.min()), float(x.max())
+    span = x1 - x0
+    tx = x[triangles]
+    windows = []
+    for depth, touches in ((tx.max(axis=1) - x0, np.any(tx <= x0 + tol, axis=1)),
+                           (x1 - tx.min(axis=1), np.any(tx >= x1 - tol, axis=1))):
+        windows.append((float(depth[touches].min()), float(depth[touches].max())))
+    (left_lo, left_hi), (right_lo, right_hi) = windows
+    lo, hi = max(left_lo, right_lo), min(left_hi, right_hi)
+    if lo > hi + 2.0 * tol:
+        raise InputError(f"mesh has first layers of triangles of different depths at its two ends "
+                         f"({left_lo:.6g} to {left_hi:.6g} m at x = {x0:.6g}, {right_lo:.6g} to {right_hi:.6g} m at "
+                         f"x = {x1:.6g}); the clamp zones 2c at both ends must match")
+    lo, hi = min(lo, hi), max(lo, hi)
+    if not lo - tol <= span - length <= hi + tol:
+        if hi - lo <= 2.0 * tol:  # one structured layer at each end: 2c is known
+            expected = f"L + 2c = {length + 0.5 * (lo + hi):.6g} m (+- {tol:.2g} m)"
+            zone = f"2c = {0.5 * (lo + hi):.6g} m, the depth of the mesh's first layer of triangles"
+        else:
+            expected = f"L + 2c between {length + lo:.6g} and {length + hi:.6g} m (+- {tol:.2g} m)"
+            zone = f"2c from {lo:.6g} to {hi:.6g} m, ending within the mesh's first layer of triangles"
+        raise InputError(f"mesh is {span:.6g} m long but the strip needs {expected}: L = {length:.6g} m between "
+                         f"the clamp lines and a clamp zone {zone}, at each end")
+    return 0.5 * (span - length)
+
+
+def mesh_from_arrays(nodes, triangles, length: float, width: float, *, clamp_depth: float | None = None,
+                     allow_unused_nodes: bool = True) -> PlateMesh:
+    """Validate a flat triangle mesh of [x0, x1] x [-W/2, W/2] and bring it to our convention.
+
+    The mesh must be one flat disc covering the rectangle L + 2c by W (c > 0; nodes within 2c
+    of each end, i.e. in the band [-c, c] around a clamp line, are clamped); it is shifted so
+    the clamp lines sit at x = 0 and x = L, triangles are made counter-clockwise, unused nodes
+    dropped (refused with allow_unused_nodes=False) and nodes ordered by x. Without
+    clamp_depth, c is inferred: the clamp zone at each end is the mesh's first layer of
+    triangles (`_inferred_clamp_depth`), so a mesh of the wrong length is refused, not clamped
+    deeper. Every defect (shape, dtype, indices, non-finite or non-flat nodes, a triangle soup,
+    duplicate nodes or triangles, degenerate, overlapping or non-manifold triangles, pieces,
+    holes, outline, size) raises a one-line InputError starting "mesh ".
+    """
+    for name, value in (("length", length), ("width", width)):
+        if isinstance(value, bool) or not (isinstance(value, (int, float, np.integer, np.floating))
+                                           and math.isfinite(value) and value > 0):
+            raise InputError(f"{name} = {value!r} must be a positive finite number of metres")
+    nodes, triangles, dtype = _check_numbers(nodes, triangles)
+    tol = coordinate_tolerance(length, nodes, dtype)
+    nodes = _check_flat(nodes, tol)
+    # unused nodes are dropped here and, if refused, only after the checks below: a hole cut
+    # out of a mesh leaves its nodes behind, and "has a hole" is the message that explains it
     used = np.unique(triangles)
-    remap = np.full(len(nodes), -1)
-    remap[used] = np.arange(len(used))
-    nodes, triangles = nodes[used], remap[triangles]
+    unused = np.setdiff1d(np.arange(len(nodes)), used)
+    unused_at = nodes[unused[0]] if len(unused) else None
+    if len(unused):
+        remap = np.full(len(nodes), -1)
+        remap[used] = np.arange(len(used))
+        nodes, triangles = nodes[used], remap[triangles]
+    _check_shared_nodes(nodes, triangles, tol)
 
     x0, x1 = nodes[:, 0].min(), nodes[:, 0].max()
     y0, y1 = nodes[:, 1].min(), nodes[:, 1].max()
-    if not math.isclose(y1 - y0, width, rel_tol=1e-6):
-        raise InputError(f"mesh width {y1 - y0:.6g} m differs from the strip width W = {width:.6g} m")
     span = x1 - x0
-    if clamp_depth is None:
-        clamp_depth = 0.5 * (span - length)
-    if not (clamp_depth > 1e-9 * length and math.isclose(span, length + 2 * clamp_depth, rel_tol=1e-9)):
-        raise InputError(
-            f"mesh length {span:.6g} m must exceed the strip length L = {length:.6g} m by a clamp zone at each end "
-            "(the mesh spans L + 2c; nodes within 2c of each end are clamped)"
-        )
-    nodes = nodes - np.array([x0 + clamp_depth, 0.5 * (y0 + y1)])
-
-    p = nodes[triangles]
-    d1, d2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-    signed = 0.5 * (d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])
-    if np.any(np.abs(signed) <= 1e-12 * span**2):
-        raise InputError("mesh has degenerate (zero-area) triangles")
+    signed = _signed_areas(nodes, triangles)
+    degenerate = np.abs(signed) <= 1e-12 * max(span, y1 - y0) ** 2
+    if np.any(degenerate):
+        example = triangles[np.argmax(degenerate)]
+        raise InputError(f"mesh has {_count(int(degenerate.sum()), 'degenerate (zero-area) triangle')} (e.g. the "
+                         f"one with corners {', '.join(_at(nodes[k]) for k in example)})")
     triangles = np.where((signed < 0)[:, None], triangles[:, [0, 2, 1]], triangles)
+    _check_disc(nodes, triangles, signed, tol)
+
+    if abs((y1 - y0) - width) > tol + 1e-6 * width:
+        hint = "; the strip must lie along x" if y1 - y0 > span else ""
+        raise InputError(f"mesh width {y1 - y0:.6g} m differs from the strip width W = {width:.6g} m "
+                         f"by more than {tol + 1e-6 * width:.2g} m{hint}")
+    if clamp_depth is None:
+        clamp_depth = _inferred_clamp_depth(nodes[:, 0], triangles, length, tol)
+    elif not (clamp_depth > 1e-9 * length and math.isclose(span, length + 2 * clamp_depth, rel_tol=1e-9)):
+        raise InputError(
+            f"mesh is {span:.6g} m long but the strip needs L + 2c = {length + 2 * clamp_depth:.6g} m "
+            f"(L = {length:.6g} m plus a clamp zone c = {clamp_depth:.6g} m beyond each clamp line; nodes within 2c "
+            "of each end are clamped)"
+        )
+    if len(unused) and not allow_unused_nodes:
+        raise InputError(f"mesh has {_count(len(unused), 'node')} used by no triangle (e.g. node {unused[0]} at "
+                         f"{_at(unused_at)}); remove them")
+    nodes = nodes - np.array([x0 + clamp_depth, 0.5 * (y0 + y1)])
 
     order = np.lexsort((nodes[:, 1], nodes[:, 0]))
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
-    mesh = PlateMesh(nodes[order], rank[triangles], float(length), float(width), float(clamp_depth))
+    mesh = PlateMesh(nodes[order], rank[triangles], float(length), float(width), float(clamp_depth), tol)
     if not mesh.clamped_left.any() or not mesh.clamped_right.any():
         raise InputError("mesh has no nodes in a clamp band")
     if mesh.clamped_left.sum() + mesh.clamped_right.sum() >= mesh.node_count:
@@ -259,14 +536,11 @@ def structured_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANG
     nodes on both edges, so interior triangles have sides h_y and sqrt(h_x^2 + h_y^2 / 4) with
     h_x ~ sqrt(3)/2 h_y (equilateral up to the rounding of n and n_y), and the edge rows hold
     half-size triangles. n_y is even and the middle column x = L/2 is regular, so the plate's
-    centre (L/2, 0) is a node.
+    centre (L/2, 0) is a node. `triangles` is an integer in [16, MAX_TRIANGLES] whose plate run
+    fits in memory (check_plate_size).
     """
-    if not (isinstance(triangles, (int, np.integer)) and not isinstance(triangles, bool) and triangles >= 16):
-        raise InputError(f"triangles = {triangles!r} must be an integer >= 16 (the paper uses ~2000)")
-    # 2 n n_y triangles in [0, L] with h_x = sqrt(3)/2 h_y
-    h_y = math.sqrt(2.0 * length * width / (0.5 * math.sqrt(3.0) * triangles))
-    n_y = _round_even(width / h_y, 2)
-    n = max(3, 2 * int(0.5 * length / (0.5 * math.sqrt(3.0) * width / n_y)) + 1)  # nearest odd
+    triangles = check_plate_size(length, width, triangles)
+    n, n_y = _structured_size(length, width, triangles)
     h_x, h_y = length / n, width / n_y
     columns = np.arange(n + 2)
     middle = (n + 1) // 2

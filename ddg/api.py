@@ -1,10 +1,11 @@
 """Python API: ddg.simulate(strip, protocol, model="rod") mirrors `python -m ddg simulate`."""
 from __future__ import annotations
 
+import os
 import platform
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +37,8 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
         raise InputError(f"a mesh is used by the plate model only, not {name!r}")
     from .geometry.plate_mesh import PlateMesh
 
+    if not isinstance(mesh, (PlateMesh, str, os.PathLike)) or isinstance(mesh, bool):
+        raise InputError(f"mesh = {mesh!r} must be a PlateMesh, a mesh file path or 'gmsh'")
     if not isinstance(mesh, PlateMesh):
         from .geometry import mesh_io
 
@@ -379,7 +382,7 @@ def simulate(
     instance = make_model(model, strip, resolution, mesh)
     if frames and out is None:
         raise InputError("frames=True needs an output directory (out)")
-    options = options or ContinuationOptions()
+    options = replace(options) if options is not None else ContinuationOptions()  # re-validated
     follower = PathFollower(instance, options)
     L = strip.length
     dL = protocol.compression_ratio * L

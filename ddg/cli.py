@@ -97,10 +97,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Most values a comma-separated list option takes (each is a run or a recorded state).
+MAX_LIST_VALUES = 50
+
+
 def _ratios(name: str, text: str, low: float, high: float, low_inclusive: bool = False) -> list[float]:
     from .centerline_approx import check_ratios
 
-    return check_ratios(name, [v for v in str(text).split(",") if v.strip()] or [text], low, high, low_inclusive)
+    values = [v for v in str(text).split(",") if v.strip()] or [text]
+    if len(values) > MAX_LIST_VALUES:
+        raise InputError(f"{name} has {len(values)} values; allowed 1 to {MAX_LIST_VALUES}")
+    return check_ratios(name, values, low, high, low_inclusive)
 
 
 #: Most centerline stations a plate profile may ask for (a profile finer than the mesh columns

@@ -134,6 +134,8 @@ def check_output_directory(out, name: str = "out") -> Path:
         text = os.fsdecode(text)
     if text.strip() == "":
         raise InputError(f"{name} = {text!r} is empty; give an output directory (e.g. out/run1)")
+    if "\0" in text:
+        raise InputError(f"{name} = {text!r} contains a NUL character; give a valid directory path")
     path = Path(text)
     try:
         if path.exists() and not path.is_dir():

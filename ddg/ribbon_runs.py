@@ -14,7 +14,7 @@ from the rod, concentrated in the quartic twist term at the inflection points.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -80,7 +80,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
         check_output_directory(out)
     if options is not None and not isinstance(options, ContinuationOptions):
         raise InputError(f"options = {options!r} must be a ddg.ContinuationOptions")
-    options = options or ContinuationOptions()
+    options = replace(options) if options is not None else ContinuationOptions()  # re-validated
     ribbon = RibbonModel(strip, resolution, zeta=zeta)
     rod = RodModel(strip, resolution) if init == "rod" else None
     driver = rod if rod is not None else ribbon

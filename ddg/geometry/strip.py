@@ -25,13 +25,18 @@ class InputError(ValueError):
     """A scene or solver input outside its allowed range (one-line message)."""
 
 
+def _is_bool(value) -> bool:
+    """True and False (Python's or numpy's) are not numbers here: width_ratio=True is a mistake."""
+    return isinstance(value, bool) or type(value).__name__ == "bool_"
+
+
 def _require(condition: bool, message: str) -> None:
     if not condition:
         raise InputError(message)
 
 
 def _finite_positive(name: str, value: float) -> float:
-    if isinstance(value, bool):
+    if _is_bool(value):
         raise InputError(f"{name} = {value!r} is a bool; it must be a positive number")
     try:
         value = float(value)
@@ -93,7 +98,7 @@ class Strip:
         for name in ("length", "width", "thickness", "young_modulus", "density"):
             object.__setattr__(self, name, _finite_positive(name, getattr(self, name)))
         nu = self.poisson_ratio
-        if isinstance(nu, bool):
+        if _is_bool(nu):
             raise InputError(f"poisson_ratio = {nu!r} is a bool; allowed range [0, 0.5)")
         try:
             nu = float(nu)
@@ -206,7 +211,7 @@ class Strip:
 
 
 def _ratio(name: str, value, low: float, high: float, upper_inclusive: bool = False) -> float:
-    if isinstance(value, bool):
+    if _is_bool(value):
         raise InputError(f"{name} = {value!r} is a bool, not a number")
     try:
         value = float(value)
@@ -251,14 +256,14 @@ class LoadingProtocol:
         for name in ("compression_steps", "shear_steps"):
             value = getattr(self, name)
             _require(
-                isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= MAX_RECORDED_STEPS,
+                isinstance(value, int) and not _is_bool(value) and 1 <= value <= MAX_RECORDED_STEPS,
                 f"{name} = {value!r} must be an integer in [1, {MAX_RECORDED_STEPS}] (an integer >= 1; more "
                 "recorded steps cost time and add nothing: the solver subdivides where it must)",
             )
-        _require(not isinstance(self.shear_sign, bool) and self.shear_sign in (1, -1),
+        _require(not _is_bool(self.shear_sign) and self.shear_sign in (1, -1),
                  f"shear_sign = {self.shear_sign!r} must be +1 or -1")
         if self.shear_ratio is not None:
-            if isinstance(self.shear_ratio, bool):
+            if _is_bool(self.shear_ratio):
                 raise InputError(f"shear_ratio = {self.shear_ratio!r} is a bool, not a number")
             try:
                 value = float(self.shear_ratio)

@@ -52,6 +52,7 @@ class ContinuationOptions:
     def __post_init__(self) -> None:
         if not isinstance(self.newton, NewtonOptions):
             raise InputError(f"ContinuationOptions(newton={self.newton!r}): must be a ddg.NewtonOptions")
+        self.newton = replace(self.newton)  # validated again: options objects can be changed after creation
         c = lambda name, *args, **kw: setattr(self, name, check_option("ContinuationOptions", name, getattr(self, name),
                                                                       *args, **kw))  # noqa: E731
         # below 2^-30 of a recorded interval the substeps are lost in round-off of the load

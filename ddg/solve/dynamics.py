@@ -94,9 +94,11 @@ class DynamicOptions:
     def __post_init__(self) -> None:
         for name in ("clamp_speed", "time_step"):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            if isinstance(value, (bool, np.bool_)) or not (isinstance(value, (int, float)) and math.isfinite(value)
+                                                           and value > 0):
                 raise InputError(f"{name} = {value!r} must be a positive finite number")
-        if not (isinstance(self.damping, (int, float)) and math.isfinite(self.damping) and self.damping >= 0):
+        if isinstance(self.damping, (bool, np.bool_)) or not (isinstance(self.damping, (int, float))
+                                                              and math.isfinite(self.damping) and self.damping >= 0):
             raise InputError(f"damping = {self.damping!r} must be a finite number >= 0 (1/s)")
         if self.record_interval is not None and not (math.isfinite(self.record_interval) and self.record_interval > 0):
             raise InputError(f"record_interval = {self.record_interval!r} must be None or a positive number (s)")
@@ -108,6 +110,7 @@ class DynamicOptions:
                 raise InputError(f"{name} = {getattr(self, name)!r} must be True or False")
         if not isinstance(self.newton, NewtonOptions):
             raise InputError(f"newton = {self.newton!r} must be a ddg.NewtonOptions")
+        self.newton = dataclasses.replace(self.newton)  # validated again (options can change after creation)
 
     def check_scene(self, strip: Strip, protocol: LoadingProtocol) -> None:
         """Refuse a clamp speed the scene cannot use, in physical terms, before any work:
@@ -295,9 +298,9 @@ def simulate_dynamic(
         raise InputError(f"strip = {strip!r} must be a ddg.Strip")
     if not isinstance(protocol, LoadingProtocol):
         raise InputError(f"protocol = {protocol!r} must be a ddg.LoadingProtocol")
-    options = options or DynamicOptions()
-    if not isinstance(options, DynamicOptions):
+    if options is not None and not isinstance(options, DynamicOptions):
         raise InputError(f"options = {options!r} must be a ddg.solve.dynamics.DynamicOptions")
+    options = dataclasses.replace(options) if options is not None else DynamicOptions()  # re-validated
     options.check_scene(strip, protocol)
     shear_ratio = protocol.resolved_shear_ratio(strip)
     model = RodModel(strip, resolution)

@@ -1,29 +1,48 @@
-"""python -m fem_reference simulate | convergence | gold: the FEM reference from the shell.
+"""python -m fem_reference simulate | convergence | convergence-table | gold: the FEM reference from the shell.
 
-Exit codes as `python -m ddg`: 0 complete, 2 bad input (one-line message), 3 the path stopped
-converging (the converged part is written, the message says where).
+Exit codes as `python -m ddg`: 0 complete, 2 bad input (a one-line message, before any mesh or
+solve and before dolfinx is imported), 3 the path stopped converging (the converged part is
+written, the message says where), 130 / 143 interrupted by SIGINT / SIGTERM (every converged step
+written, summary.json status "interrupted"), 1 any other failure (one line: a missing FEM
+package, out of memory, a file that cannot be written, an internal error; FEM_REFERENCE_TRACEBACK=1
+shows the traceback of the last).
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+
+EXIT_FAILURE = 1
+EXIT_BAD_INPUT = 2
+EXIT_NOT_CONVERGED = 3
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2, no usage dump (as ddg.cli)
+        sys.stderr.write(f"error: {' '.join(str(message).split())}\n")
+        raise SystemExit(EXIT_BAD_INPUT)
 
 
 def _add_scene(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--width-ratio", type=float, required=True, help="W/L")
-    p.add_argument("--compression-ratio", type=float, required=True, help="dL/L")
+    p.add_argument("--width-ratio", type=float, required=True, help="W/L in (0, 1]")
+    p.add_argument("--compression-ratio", type=float, required=True, help="dL/L in [0.001, 0.9]")
     p.add_argument("--shear-ratio", type=float, default=None, help="largest dW/L (default dW_max/L, Eq. B.1)")
-    p.add_argument("--slenderness", type=float, default=None, help="L/b (default b = 0.127 mm)")
-    p.add_argument("--poisson-ratio", type=float, default=0.0)
-    p.add_argument("--compression-steps", type=int, default=40)
-    p.add_argument("--shear-steps", type=int, default=120)
+    p.add_argument("--slenderness", type=float, default=None, help="L/b in [10, 1e5] (default b = 0.127 mm)")
+    p.add_argument("--poisson-ratio", type=float, default=0.0, help="nu in [0, 0.5) (default 0)")
+    p.add_argument("--compression-steps", type=int, default=40, help="recorded compression steps, 1..5000 (default 40)")
+    p.add_argument("--shear-steps", type=int, default=120, help="recorded shear steps, 1..5000 (default 120)")
     p.add_argument("--shear-sign", type=int, default=1, choices=(1, -1))
 
 
 def _scene(args):
+    """Strip and LoadingProtocol of the scene options (ddg validates them: one-line InputError)."""
     from ddg.geometry.strip import LoadingProtocol, Strip
+    from ddg.limits import check_steps
 
+    check_steps("--compression-steps", args.compression_steps)
+    check_steps("--shear-steps", args.shear_steps)
     strip = Strip.from_ratios(args.width_ratio, args.compression_ratio, args.slenderness,
                               poisson_ratio=args.poisson_ratio)
     protocol = LoadingProtocol(args.compression_ratio, args.shear_ratio, args.compression_steps,
@@ -32,28 +51,40 @@ def _scene(args):
     return strip, protocol
 
 
+#: Option names of the command line, for api.check_inputs' messages.
+OPTION_NAMES = {"resolution": "--resolution", "across": "--across", "out": "--out", "perturbation": "--perturbation"}
+
+
+def _thresholds_note(s: dict) -> str:
+    found = [f"{label} = {s[key]:.4f}" for key, label in (("dW1_over_L", "dW1/L"), ("dW2_over_L", "dW2/L"))
+             if s.get(key) is not None]
+    return f"; located before it: {', '.join(found)}" if found else "; no threshold located"
+
+
 def cmd_simulate(args) -> int:
-    from .continuation import ContinuationOptions
+    from .api import check_inputs
 
     strip, protocol = _scene(args)
-    if args.perturbation <= 0:
-        from ddg.geometry.strip import InputError
-
-        raise InputError(f"perturbation = {args.perturbation!r} must be > 0")
+    # every input checked before dolfinx is imported (api.simulate checks them again, cheaply)
+    check_inputs(strip, protocol, args.resolution, args.across, args.material, args.out, args.perturbation,
+                 names=OPTION_NAMES)
     from .api import simulate
+    from .continuation import ContinuationOptions
 
     options = ContinuationOptions(perturbation=args.perturbation, branch_switching=not args.no_branch_switching,
                                   thresholds=not args.no_thresholds)
     result = simulate(strip, protocol, args.resolution, out=args.out, options=options, across=args.across,
                       fields=not args.no_fields, progress=not args.quiet, material=args.material)
+    args.finished_in = args.out or ""  # for the message of a Ctrl-C from here on
     s = result.summary
     if not args.quiet:
         keys = ("H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
-                "newton_iterations", "wall_time_s", "converged", "message")
-        print(json.dumps({k: s[k] for k in keys}, indent=1))
+                "newton_iterations", "wall_time_s", "converged", "status", "message")
+        print(json.dumps({k: s.get(k) for k in keys}, indent=1))
     if not result.converged:
-        print(f"error: {s['message']}", file=sys.stderr)
-        return 3
+        where = f"; the converged part is written to {args.out}" if args.out is not None else ""
+        print(f"error: run did not complete: {s['message']}{_thresholds_note(s)}{where}", file=sys.stderr)
+        return EXIT_NOT_CONVERGED
     return 0
 
 
@@ -76,25 +107,29 @@ def cmd_gold(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="python -m fem_reference", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser = _Parser(prog="python -m fem_reference", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     p = sub.add_parser("simulate", help="one run: path.csv, summary.json, centerline.csv, fields.xdmf")
     _add_scene(p)
-    p.add_argument("--resolution", type=int, default=60, help="elements along L (default 60)")
-    p.add_argument("--across", type=int, default=None, help="elements across W (default: near-isotropic)")
-    p.add_argument("--perturbation", type=float, default=1e-3, help="branch-switch start amplitude / L")
+    p.add_argument("--resolution", type=int, default=60,
+                   help="elements along L, 4..400, odd rounded up to even (default 60)")
+    p.add_argument("--across", type=int, default=None,
+                   help="elements across W, 2..400, odd rounded up to even (default: near-isotropic)")
+    p.add_argument("--perturbation", type=float, default=1e-3,
+                   help="branch-switch start amplitude / L, in [1e-6, 0.1] (default 1e-3)")
     p.add_argument("--no-branch-switching", action="store_true")
     p.add_argument("--material", choices=("isotropic", "dep"), default="isotropic",
                    help="isotropic (the strip's Poisson ratio, default) or dep: the DDG plate's continuum limit "
                         "(nu = 1/3 membrane, nu_b = -1/3 bending, D = E b^3/12)")
     p.add_argument("--no-thresholds", action="store_true")
     p.add_argument("--no-fields", action="store_true", help="skip fields.xdmf")
-    p.add_argument("--out", default=None)
+    p.add_argument("--out", default=None, help="output directory (default: nothing written)")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_simulate)
-    p = sub.add_parser("convergence", help="3-4 meshes, Richardson extrapolation, CSV + markdown table")
+    p = sub.add_parser("convergence", help="2-6 meshes, Richardson extrapolation, CSV + markdown table")
     _add_scene(p)
-    p.add_argument("--resolutions", type=int, nargs="+", default=[60, 90, 120])
+    p.add_argument("--resolutions", type=int, nargs="+", default=[60, 90, 120],
+                   help="elements along L of each mesh, 4..400 each (default 60 90 120)")
     p.add_argument("--out", required=True)
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_convergence)
@@ -106,19 +141,81 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True)
     p.add_argument("--only", nargs="*", default=None,
                    help="scene names to run (e.g. dL0.5_W0.1667); default all")
-    p.add_argument("--resolution", type=int, default=None, help="elements along L (default: per scene)")
+    p.add_argument("--resolution", type=int, default=None, help="elements along L, 4..400 (default: per scene)")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_gold)
     return parser
 
 
+def _one_line(text) -> str:
+    return " ".join(str(text).split())
+
+
+def _interrupt_behind(exc: BaseException) -> BaseException | None:
+    """The KeyboardInterrupt an exception was raised while handling (e.g. an extension module's
+    ImportError "initialization failed" when Ctrl-C hits its import), if any."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
+
+
+def _interrupted(exc: BaseException, args) -> int:
+    """One line for a run stopped by SIGINT/SIGTERM; the exit code 128 + the signal number."""
+    from ddg.interrupts import exit_code_of, signal_name_of
+
+    message = getattr(exc, "run_message", None)
+    if message is None:
+        message = f"interrupted by {signal_name_of(exc)}"
+        if getattr(args, "command", None) == "simulate":
+            done = getattr(args, "finished_in", None)
+            message += (f" after the run; its files are complete in {done}" if done
+                        else " after the run" if done is not None else " before the run started; nothing computed")
+    folder = getattr(exc, "run_folder", None)
+    if folder is not None:
+        message += f"; written to {folder} (summary.json status 'interrupted')"
+    elif getattr(exc, "result", None) is not None:
+        message += "; nothing written (no --out)"
+    sys.stderr.write(f"error: {_one_line(message)}\n")
+    return exit_code_of(exc)
+
+
 def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
+    from ddg.interrupts import terminate_as_interrupt
 
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    terminate_as_interrupt()  # SIGTERM raises an interrupt too: every converged step is written
+    args = None
     try:
+        args = build_parser().parse_args(argv)
         return args.func(args)
+    except SystemExit as exc:  # --help (0) or a bad option (2, its line already written)
+        return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
     except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        sys.stderr.write(f"error: {_one_line(exc)}\n")
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt as exc:
+        return _interrupted(exc, args)
+    except Exception as exc:
+        interrupt = _interrupt_behind(exc)
+        if interrupt is not None:
+            return _interrupted(interrupt, args)
+        folder = getattr(exc, "run_folder", None)
+        kept = f"; the converged part is written to {folder} (summary.json status 'error')" if folder else ""
+        if isinstance(exc, ImportError):
+            sys.stderr.write(f"error: the FEM reference needs dolfinx 0.5, petsc4py, slepc4py, mpi4py and gmsh "
+                             f"(scripts/setup.sh installs them): {_one_line(exc)}\n")
+        elif isinstance(exc, MemoryError):
+            sys.stderr.write(f"error: out of memory; use a coarser mesh (--resolution, --across){kept}\n")
+        elif isinstance(exc, OSError):
+            name = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+            sys.stderr.write(f"error: {name}{_one_line(exc.strerror or exc)}{kept}\n")
+        else:  # a bug: one line (FEM_REFERENCE_TRACEBACK=1 for the traceback)
+            if os.environ.get("FEM_REFERENCE_TRACEBACK"):
+                raise
+            sys.stderr.write(f"error: internal error: {type(exc).__name__}: {_one_line(exc)}{kept} "
+                             "(FEM_REFERENCE_TRACEBACK=1 shows the traceback)\n")
+        return EXIT_FAILURE

@@ -17,6 +17,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -51,13 +52,43 @@ def extrapolate(values: np.ndarray, resolutions, default_order=2.0):
     return richardson(values[-2], values[-1], r, p), p
 
 
+#: Meshes of one convergence study: at least 2 (Richardson extrapolation needs two; one mesh
+#: would report zero errors), at most 6 (each is a whole path, 5-20 minutes at 60-120 elements).
+MIN_MESHES, MAX_MESHES = 2, 6
+
+
+def check_resolutions(resolutions, width_ratio: float, name: str = "--resolutions") -> list[int]:
+    """Distinct element counts along L (after rounding up to even), each within the mesh bounds
+    and the machine's memory (mesh.checked_spec); sorted. One-line InputError otherwise."""
+    from ddg.geometry.strip import InputError
+
+    from .mesh import checked_spec
+
+    values = list(resolutions)
+    if not MIN_MESHES <= len(values) <= MAX_MESHES:
+        raise InputError(f"{name} = {values} has {len(values)} meshes; give {MIN_MESHES} to {MAX_MESHES} "
+                         "(Richardson extrapolation needs two; each is a whole path)")
+    specs = {}
+    for value in values:
+        spec = checked_spec(value, width_ratio, None, name)
+        if spec.nx in specs:
+            raise InputError(f"{name} = {values}: {specs[spec.nx]} and {value} give the same mesh "
+                             f"({spec.nx} elements along L: odd counts are rounded up to even); give distinct meshes")
+        specs[spec.nx] = value
+    return sorted(int(v) for v in values)
+
+
 def run_convergence(args) -> int:
-    from .api import simulate
+    from ddg.io import check_output_directory
+
+    from .api import check_inputs, simulate
     from .cli import _scene
 
     strip, protocol = _scene(args)
-    out = Path(args.out)
-    resolutions = sorted(args.resolutions)
+    resolutions = check_resolutions(args.resolutions, strip.width_ratio)
+    out = check_output_directory(args.out, "--out")
+    for n in resolutions:  # every run's inputs and folder checked before the first is computed
+        check_inputs(strip, protocol, n, out=out / f"N{n}", names={"resolution": "--resolutions", "out": "--out"})
     runs = []
     for n in resolutions:
         result = simulate(strip, protocol, n, out=out / f"N{n}", fields=False, progress=not args.quiet)
@@ -70,24 +101,73 @@ def run_convergence(args) -> int:
     return 0 if all(r.converged for r in runs) else 3
 
 
+def load_runs(folders, name: str = "--runs") -> list:
+    """The stored runs of `convergence-table --runs`, each a finished run folder with a
+    compressed state and shear steps; one-line InputError naming the folder otherwise."""
+    import json
+
+    from ddg.geometry.strip import InputError
+    from ddg.io import STATUS_RUNNING, StoredRun
+
+    folders = list(folders)
+    if len(folders) < MIN_MESHES:
+        raise InputError(f"{name} = {folders} has {len(folders)} folder(s); give the runs of one scene on "
+                         f"{MIN_MESHES} or more meshes")
+    runs = []
+    for folder in folders:
+        text = str(folder)
+        if text.strip() == "" or not os.path.isdir(text):
+            raise InputError(f"{name}: {text!r} is not a directory")
+        for file in ("summary.json", "path.csv"):
+            if not os.path.isfile(os.path.join(text, file)):
+                raise InputError(f"{name}: {text!r} has no {file}; give the output folder of a run")
+        try:
+            run = StoredRun(text)
+            scene = run.summary["scene"]
+            key = (float(scene["width_ratio"]), float(scene["compression_ratio"]), float(scene["slenderness"]))
+            resolution = int(scene["resolution"])
+            for needed in ("mesh", "n_dof", "recorded_steps", "dW1_over_L", "dW2_over_L", "wall_time_s",
+                           "newton_iterations", "converged"):
+                run.summary[needed]
+            shear = [r for r in run.rows if r["stage"] == "shear"]
+            for row in run.rows:
+                float(row["dW_over_L"]), float(row["H_mid_over_L"]), row["phase"]
+        except (OSError, UnicodeDecodeError) as exc:
+            raise InputError(f"{name}: {text!r} cannot be read: {exc}") from None
+        except (ValueError, KeyError, TypeError, AttributeError) as exc:  # json.JSONDecodeError is a ValueError
+            what = f"missing {exc}" if isinstance(exc, KeyError) else f"{type(exc).__name__}: {exc}"
+            raise InputError(f"{name}: {text!r} is not a run folder of fem_reference ({what})") from None
+        if run.summary.get("status") == STATUS_RUNNING:
+            raise InputError(f"{name}: {text!r} holds a run still in progress or killed (summary.json status "
+                             "'running'); rerun it")
+        if run.summary.get("H_mid_over_L_compressed") is None or not shear:
+            raise InputError(f"{name}: {text!r} has no shear steps (the run stopped before the shear stage)")
+        if run.summary.get("model") not in (None, "fem"):
+            raise InputError(f"{name}: {text!r} is a run of model {json.dumps(run.summary.get('model'))}, "
+                             "not of fem_reference")
+        runs.append((key, resolution, run))
+    return runs
+
+
 def table_from_runs(args) -> int:
     """`convergence-table --runs DIR ...`: the convergence table of finished runs of one scene."""
     from ddg.geometry.strip import InputError, LoadingProtocol, Strip
-    from ddg.io import StoredRun
+    from ddg.io import check_output_directory
 
-    runs = [StoredRun(d) for d in args.runs]
-    scenes = {(r.summary["scene"]["width_ratio"], r.summary["scene"]["compression_ratio"],
-               r.summary["scene"]["slenderness"]) for r in runs}
+    loaded = load_runs(args.runs)
+    scenes = {key for key, _, _ in loaded}
     if len(scenes) != 1:
         raise InputError(f"the runs are of different scenes {sorted(scenes)}; give runs of one scene")
-    runs.sort(key=lambda r: r.summary["scene"]["resolution"])
-    resolutions = [r.summary["scene"]["resolution"] for r in runs]
+    loaded.sort(key=lambda item: item[1])
+    resolutions = [resolution for _, resolution, _ in loaded]
     if len(set(resolutions)) != len(resolutions):
         raise InputError(f"resolutions {resolutions} repeat; give one run per mesh")
+    out = check_output_directory(args.out, "--out")
+    runs = [run for _, _, run in loaded]
     width, compression, slenderness = scenes.pop()
     strip = Strip.from_ratios(width, compression, slenderness)
     rows, table = summarise(runs, resolutions)
-    write_outputs(Path(args.out), rows, table, runs, resolutions, strip, LoadingProtocol(compression))
+    write_outputs(out, rows, table, runs, resolutions, strip, LoadingProtocol(compression))
     return 0
 
 

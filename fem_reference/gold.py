@@ -35,39 +35,70 @@ def scenes() -> list[tuple[str, float, float]]:
     return [(scene_name(c, w), c, w) for c, w in first + rest]
 
 
-def run_gold(args) -> int:
-    from ddg.geometry.strip import InputError, LoadingProtocol, Strip
+def _read_summary(path: Path) -> dict | None:
+    """summary.json of a scene folder, None if missing or unreadable (an unreadable one is rerun)."""
+    try:
+        summary = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return summary if isinstance(summary, dict) else None
 
-    from .api import simulate
 
-    out = Path(args.out)
-    known = {name for name, _, _ in scenes()}
+def check_gold_inputs(args) -> list[tuple[str, float, float, int]]:
+    """The scenes to run as (name, dL/L, W/L, resolution), every input checked before any work:
+    --only names known, --resolution within the mesh bounds and memory (mesh.checked_spec) for
+    every selected scene, --out writable. One-line InputError otherwise."""
+    from ddg.geometry.strip import InputError
+    from ddg.io import check_output_directory
+
+    from .mesh import checked_spec
+
+    known = [name for name, _, _ in scenes()]
     only = args.only or None
     if only:
-        unknown = sorted(set(only) - known)
+        unknown = [name for name in dict.fromkeys(only) if name not in known]
         if unknown:
-            raise InputError(f"unknown gold scene(s) {unknown}; choose from {sorted(known)}")
-    status = 0
+            raise InputError(f"--only: unknown gold scene(s) {', '.join(map(repr, unknown))}; "
+                             f"choose from {', '.join(known)}")
+    selected = []
     for name, dL, W in scenes():
         if only and name not in only:
             continue
-        resolution = args.resolution or GOLD_RESOLUTIONS.get(name, GOLD_RESOLUTION)
-        target = out / name
-        summary_path = target / "summary.json"
-        if summary_path.exists():
-            old = json.loads(summary_path.read_text())
-            if old.get("converged") and old["scene"].get("resolution") == resolution:
+        resolution = GOLD_RESOLUTIONS.get(name, GOLD_RESOLUTION) if args.resolution is None else args.resolution
+        checked_spec(resolution, W, None, "--resolution")
+        selected.append((name, dL, W, int(resolution)))
+    check_output_directory(args.out, "--out")
+    return selected
+
+
+def run_gold(args) -> int:
+    from ddg.geometry.strip import LoadingProtocol, Strip
+
+    from .api import simulate
+
+    selected = check_gold_inputs(args)
+    out = Path(args.out)
+    status = 0
+    try:
+        for name, dL, W, resolution in selected:
+            target = out / name
+            old = _read_summary(target / "summary.json")
+            if old and old.get("converged") and (old.get("scene") or {}).get("resolution") == resolution:
                 continue
-        strip = Strip.from_ratios(W, dL)
-        protocol = LoadingProtocol(dL)
-        t0 = time.perf_counter()
-        result = simulate(strip, protocol, resolution, out=target, fields=False, progress=not args.quiet)
-        if not args.quiet:
-            print(f"{name}: converged {result.converged}, {time.perf_counter() - t0:.0f} s, "
-                  f"dW1/L {result.summary['dW1_over_L']}, dW2/L {result.summary['dW2_over_L']}", flush=True)
-        status = status or (0 if result.converged else 3)
-        write_index(out)
-    write_index(out)
+            strip = Strip.from_ratios(W, dL)
+            protocol = LoadingProtocol(dL)
+            t0 = time.perf_counter()
+            result = simulate(strip, protocol, resolution, out=target, fields=False, progress=not args.quiet)
+            if not args.quiet:
+                print(f"{name}: converged {result.converged}, {time.perf_counter() - t0:.0f} s, "
+                      f"dW1/L {result.summary['dW1_over_L']}, dW2/L {result.summary['dW2_over_L']}", flush=True)
+            status = status or (0 if result.converged else 3)
+            write_index(out)
+    finally:  # also after Ctrl-C: the index lists the interrupted scene as not complete
+        from ddg.interrupts import deferred_signals
+
+        with deferred_signals():
+            write_index(out)
     return status
 
 
@@ -75,17 +106,18 @@ def write_index(out: Path) -> None:
     """OUT/index.json: every scene folder with a summary, its mesh, wall time and thresholds."""
     index = {}
     for name, dL, W in scenes():
-        path = out / name / "summary.json"
-        if not path.exists():
+        s = _read_summary(out / name / "summary.json")
+        if s is None:
             continue
-        s = json.loads(path.read_text())
-        index[name] = {"compression_ratio": dL, "width_ratio": W, "converged": s["converged"],
-                       "message": s["message"], "resolution": s["scene"]["resolution"],
-                       "triangles": s["mesh"]["triangles"], "n_dof": s["n_dof"],
-                       "wall_time_s": s["wall_time_s"], "H_mid_over_L_compressed": s["H_mid_over_L_compressed"],
-                       "dW1_over_L": s["dW1_over_L"], "dW2_over_L": s["dW2_over_L"],
-                       "dW_max_over_L": s["dW_max_over_L"],
-                       "resolved_up_to_dW_over_L": s["resolved_up_to_dW_over_L"]}
+        scene, mesh = s.get("scene") or {}, s.get("mesh") or {}
+        index[name] = {"compression_ratio": dL, "width_ratio": W, "converged": bool(s.get("converged")),
+                       "status": s.get("status"), "message": s.get("message", ""),
+                       "resolution": scene.get("resolution"), "triangles": mesh.get("triangles"),
+                       "n_dof": s.get("n_dof"), "wall_time_s": s.get("wall_time_s"),
+                       "H_mid_over_L_compressed": s.get("H_mid_over_L_compressed"),
+                       "dW1_over_L": s.get("dW1_over_L"), "dW2_over_L": s.get("dW2_over_L"),
+                       "dW_max_over_L": s.get("dW_max_over_L"),
+                       "resolved_up_to_dW_over_L": s.get("resolved_up_to_dW_over_L")}
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "index.json", json.dumps(index, indent=2) + "\n")
     write_readme(out, index)
@@ -122,10 +154,18 @@ unreliable: 0.009 L). The other gold scenes are on 60 elements, where the same s
 def write_readme(out: Path, index: dict) -> None:
     """OUT/README.md: how to regenerate, and the table of the scenes that exist."""
     missing = [name for name, _, _ in scenes() if name not in index]
-    fmt = lambda v: "-" if v is None else f"{v:.4f}"  # noqa: E731
-    rows = [f"| {name} | {e['resolution']} | {e['triangles']} | {e['n_dof']} | {e['H_mid_over_L_compressed']:.6f} "
-            f"| {fmt(e['dW1_over_L'])} | {fmt(e['dW2_over_L'])} | {'yes' if e['converged'] else 'no: ' + e['message']} "
-            f"| {e['wall_time_s']:.0f} |" for name, e in index.items()]
+
+    def fmt(v, spec="{:.4f}"):
+        return "-" if not isinstance(v, (int, float)) or isinstance(v, bool) else spec.format(v)
+
+    def complete(e):
+        if e["converged"]:
+            return "yes"
+        return f"no ({e['status']}): {e['message']}" if e.get("status") else f"no: {e['message']}"
+
+    rows = [f"| {name} | {fmt(e['resolution'], '{}')} | {fmt(e['triangles'], '{}')} | {fmt(e['n_dof'], '{}')} "
+            f"| {fmt(e['H_mid_over_L_compressed'], '{:.6f}')} | {fmt(e['dW1_over_L'])} | {fmt(e['dW2_over_L'])} "
+            f"| {complete(e)} | {fmt(e['wall_time_s'], '{:.0f}')} |" for name, e in index.items()]
     text = README_HEAD + "\n".join(rows) + "\n"
     if missing:
         text += f"\nNot yet run (one command away, see above): {', '.join(missing)}.\n"

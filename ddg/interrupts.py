@@ -45,8 +45,11 @@ def _raise_interrupted(signum, frame):
 def terminate_as_interrupt() -> None:
     """SIGTERM (and SIGINT) raise RunInterrupted in the main thread (command-line entry points)."""
     if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGTERM, _raise_terminated)
-        signal.signal(signal.SIGINT, _raise_interrupted)
+        # a signal the caller ignores stays ignored (a shell starts background jobs with SIGINT ignored)
+        if signal.getsignal(signal.SIGTERM) != signal.SIG_IGN:
+            signal.signal(signal.SIGTERM, _raise_terminated)
+        if signal.getsignal(signal.SIGINT) != signal.SIG_IGN:
+            signal.signal(signal.SIGINT, _raise_interrupted)
 
 
 @contextlib.contextmanager

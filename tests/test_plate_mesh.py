@@ -457,13 +457,13 @@ def test_structured_mesh_refuses_a_size_beyond_the_memory(monkeypatch):
     """Refused from the estimate, before the mesh is built."""
     import ddg.limits
 
-    monkeypatch.setattr(ddg.limits, "available_memory_bytes", lambda: 64 * 2.0**20)  # 32 MiB for a run
+    monkeypatch.setattr(ddg.limits, "available_memory_bytes", lambda: 64 * 2.0**20)  # 48 MiB for a run
     structured_mesh(LENGTH, 0.05, 500)
     estimate = plate_memory_estimate_bytes(LENGTH, 0.05, 4000)
     with pytest.raises(InputError) as info:
         structured_mesh(LENGTH, 0.05, 4000)
     assert str(info.value) == (f"triangles = 4000 needs about {estimate / 2**30:.3g} GiB; this machine allows "
-                               f"{32 / 1024:.3g} GiB for a run (50 % of the memory available)")
+                               f"{48 / 1024:.3g} GiB for a run (75 % of its memory)")
 
 
 @pytest.mark.parametrize("width", WIDTHS)

@@ -105,18 +105,29 @@ def unresolved_reason(rows: list[dict], shear_ratio: float) -> str | None:
     43, 30 and 20 degrees at M = 7, 10, 14, 20 and 30, with dW1/L errors 0.055, 0.003, 0.007,
     0.004, 0.002 against M = 100."""
     past = False
+    worst_turn = worst_strain = None
     for row in rows:
         if row["stage"] == "shear" and abs(row["dW_over_L"]) > shear_ratio:
             if past:
                 break
             past = True
-        turn, strain = row.get("max_turn_angle_deg", 0.0), row.get("max_strain", 0.0)
-        where = f"dL/L = {row['dL_over_L']:.4g}, dW/L = {abs(row['dW_over_L']):.4g}"
-        if turn > RESOLVED_TURN_ANGLE_DEG:
-            return (f"at {where} neighbouring elements turn by {turn:.0f} degrees (resolved up to "
-                    f"{RESOLVED_TURN_ANGLE_DEG:g}); refine the resolution")
-        if strain > RESOLVED_STRAIN:
-            return f"at {where} the strain reaches {strain:.3g} (resolved up to {RESOLVED_STRAIN:g}); refine the resolution"
+        if worst_turn is None or row.get("max_turn_angle_deg", 0.0) > worst_turn.get("max_turn_angle_deg", 0.0):
+            worst_turn = row
+        if worst_strain is None or row.get("max_strain", 0.0) > worst_strain.get("max_strain", 0.0):
+            worst_strain = row
+    if worst_turn is None:
+        return None
+
+    def where(row):
+        return f"dL/L = {row['dL_over_L']:.4g}, dW/L = {abs(row['dW_over_L']):.4g}"
+
+    turn, strain = worst_turn.get("max_turn_angle_deg", 0.0), worst_strain.get("max_strain", 0.0)
+    if turn > RESOLVED_TURN_ANGLE_DEG:
+        return (f"neighbouring elements turn by up to {turn:.0f} degrees (at {where(worst_turn)}; resolved up to "
+                f"{RESOLVED_TURN_ANGLE_DEG:g}); refine the resolution")
+    if strain > RESOLVED_STRAIN:
+        return (f"the strain reaches {strain:.3g} (at {where(worst_strain)}; resolved up to {RESOLVED_STRAIN:g}); "
+                "refine the resolution")
     return None
 
 

@@ -25,13 +25,13 @@ from .rod_curvature import StencilGeometry, curvature_derivatives
 from .rod_twist import twist_derivatives
 
 
-ZETA_RANGE = (1e-9, 1e9)
+ZETA_RANGE = (1e-9, 1e15)
 
 
 def check_zeta(zeta) -> float:
-    """zeta (m) within ZETA_RANGE, else InputError. 1/zeta^2 must stay a normal float well above
-    round-off of k2^2 and below overflow: 1e-9 m to 1e9 m (the paper's 1e8; results stop
-    changing from zeta ~ 10 L)."""
+    """zeta (m) within ZETA_RANGE, else InputError. 1/zeta^2 must stay a nonzero normal float,
+    so the denominator of the quartic term never vanishes where k2 = 0 (zeta = 1e300 makes it
+    0), and finite: 1e-9 m to 1e15 m (the paper's 1e8; results stop changing from zeta ~ 10 L)."""
     low, high = ZETA_RANGE
     if isinstance(zeta, bool):
         raise InputError(f"zeta = {zeta!r} is a bool; allowed: a length in [{low:g}, {high:g}] m")

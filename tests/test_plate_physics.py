@@ -24,7 +24,9 @@ def height(result):
 def test_compressed_plate_matches_clamped_elastica_at_the_default_mesh():
     exact = clamped_elastica_midpoint_height(0.5)
     error = abs(height(compress(1 / 6, 2000)) - exact) / exact
-    assert error < 5e-3
+    # measured 2.8e-4 (the thickness offset of test_plate_elastica_offset_is_a_thickness_effect; the
+    # mesh error is below 6e-5 from 300 triangles up): 1e-3 is 3.6 times that
+    assert error < 1e-3
 
 
 def test_plate_elastica_error_falls_under_refinement():
@@ -151,7 +153,8 @@ def test_resolution_indicators_of_the_compressed_plate():
     result = compress(1 / 6, 1000)
     row = result.rows[-1]
     spacing = 2.0 * result.model.mesh.clamp_depth / result.model.strip.length
-    assert row["max_turn_angle_deg"] == pytest.approx(np.degrees(9.94 * spacing), rel=0.05)
+    # measured 3.6e-4 off at 1000 triangles; kappa_max L = 9.94 is quoted to 5e-4: 1.5e-3 is 3-4 times either
+    assert row["max_turn_angle_deg"] == pytest.approx(np.degrees(9.94 * spacing), rel=1.5e-3)
     surface_strain = 0.5 * result.model.strip.thickness * 9.94 / result.model.strip.length
     assert row["max_strain"] < 0.2 * surface_strain
     assert result.summary["resolved_up_to_dW_over_L"] is None  # no shear recorded

@@ -1,8 +1,10 @@
 """The agreements the report claims, each with its bound, evaluated on runs.
 
 The report evaluates every claim on its own runs and prints the measured value, the bound and
-whether it holds; tests/test_validation.py asserts the same claims (the same functions and bounds)
-on quick runs, so the report cannot state an agreement the test suite does not check.
+whether it holds (a claim whose runs or reference data are missing does not hold: "no data").
+tests/test_validation.py asserts every claim with the same functions and bounds on runs it makes
+itself (same scenes; where its plate is coarser than the report's, the test says so), so the report
+cannot state an agreement the test suite does not check; a claim that does not hold fails its test.
 
 A run here is anything with `.rows` (path.csv rows as dicts of numbers and strings) and `.summary`
 (summary.json as a dict): a ddg.SimulationResult, a validation RunResult or a FEM GoldCurve.
@@ -28,12 +30,15 @@ class Claim:
 CLAIMS = {c.key: c for c in (
     Claim("rod_elastica", "rod (M = 100) H_mid/L after compression to dL/L = 1/2 vs the exact clamped elastica, "
           "relative error", 1e-3),
+    # measured -2.8e-4 at 1000 and 2000 triangles (a free-edge thickness offset, the same within 6e-5 from
+    # 300 to 8000 triangles): 1e-3 is 3.6 times that
     Claim("plate_elastica", "plate (W/L = 1/6) H_mid/L after compression to dL/L = 1/2 vs the exact elastica, "
-          "relative error", 2e-3),
+          "relative error", 1e-3),
     Claim("ribbon_elastica", "ribbon (M = 101, W/L = 1/20) H_mid/L after compression to dL/L = 1/2 vs the exact "
           "elastica, relative error", 1e-3),
+    # measured -7.7e-5 (data/fem_gold, 120 x 20 elements): 3e-4 is 3.9 times that
     Claim("fem_elastica", "FEM shell (W/L = 1/6) H_mid/L after compression to dL/L = 1/2 vs the exact elastica, "
-          "relative error", 5e-3),
+          "relative error", 3e-4),
     Claim("rod_vs_plate_narrow_U", "rod vs plate at W/L = 1/20, dL/L = 1/2: largest H_mid difference/L on the "
           "U branch (dW up to 0.02 below the first dW1)", 0.01),
     Claim("plate_vs_fem_curve", "plate (about 6000 triangles) vs FEM gold at W/L = 1/6, dL/L = 1/2: largest H_mid "
@@ -97,8 +102,17 @@ def paper_threshold_error(run) -> float | None:
     return max(errors) if errors else None
 
 
-def evaluate(key: str, measured) -> dict:
+def evaluate(key: str, measured, missing: str = "") -> dict:
+    """The verdict on one claim: measured |value| against its bound. A claim without a finite
+    measured value does not hold (holds False, reason "no data: ..."): the report cannot claim
+    an agreement it did not measure. `missing` says what was missing (the runs or reference data)."""
     claim = CLAIMS[key]
     value = None if measured is None or not np.isfinite(measured) else abs(float(measured))
+    if value is None:
+        what = missing or ("no finite measured value" if measured is not None else "no measured value")
+        holds, reason = False, f"no data: {what}"
+    else:
+        holds = bool(value <= claim.bound)
+        reason = f"measured {value:.4g} {'<=' if holds else '>'} bound {claim.bound:g}"
     return {"claim": key, "statement": claim.statement, "bound": claim.bound, "measured": value,
-            "holds": None if value is None else bool(value <= claim.bound)}
+            "holds": holds, "reason": reason}

@@ -5,7 +5,8 @@ summary.json, branches.csv) are cached under CACHE/<key>/, where key is a hash o
 and of the ddg source code, so a rerun computes only what changed and an interrupted report
 resumes without losing finished runs (a run counts as finished once CACHE/<key>/spec.json exists;
 it is written last, atomically). FEM reference curves are not run here: they are read from the
-gold data (validation/fem_gold.py).
+gold data in data/fem_gold (validation/reference.py load_gold), which `python -m fem_reference gold
+--out data/fem_gold` regenerates (data/fem_gold/README.md).
 """
 from __future__ import annotations
 

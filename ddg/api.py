@@ -299,6 +299,18 @@ def finish_summary(summary: dict, rows: list[dict], *, path_complete: bool, stop
         summary.update(status=STATUS_COMPLETE, converged=True, message="path complete")
 
 
+def conclude_run(folder, result, interrupted: BaseException | None, error: BaseException | None):
+    """Write the result's files into its folder (atomically, signals held) and return it; an
+    interruption or an unexpected error is re-raised after that, with the result as exc.result."""
+    if folder is not None:
+        folder.finish(result)
+    if interrupted is not None or error is not None:
+        raised = interrupted if interrupted is not None else error
+        raised.result = result
+        raise raised
+    return result
+
+
 def open_run_folder(out, summary: dict, trailing: tuple[str, ...] = ()):
     """The RunFolder of `out` (None if out is None), marked in progress with this summary."""
     if out is None:
@@ -464,10 +476,4 @@ def simulate(
     if writer is not None:
         writer.close()
     result = SimulationResult(rows, summary, state, instance, centerlines, branch_rows)
-    if folder is not None:
-        folder.finish(result)
-    if interrupted is not None or error is not None:
-        raised = interrupted if interrupted is not None else error
-        raised.result = result
-        raise raised
-    return result
+    return conclude_run(folder, result, interrupted, error)

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .api import (CENTERLINE_STATIONS, SimulationResult, base_summary, check_resolution, check_thresholds_resolved,
+                  conclude_run,
                   fill_thresholds, finish_summary, open_run_folder, ProgressBar, track_brackets)
 from .geometry.frames import cross, rowdot
 from .geometry.strip import InputError, LoadingProtocol, Strip
@@ -156,13 +157,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
                    stage=stage, error=error)
     result = RibbonResult(rows, summary, state, ribbon, centerlines, rod_rows=rod_rows)
-    if folder is not None:
-        folder.finish(result)
-    if interrupted is not None or error is not None:
-        raised = interrupted if interrupted is not None else error
-        raised.result = result
-        raise raised
-    return result
+    return conclude_run(folder, result, interrupted, error)
 
 
 def rod_thresholds(summary: dict, rod, options: ContinuationOptions, brackets: dict, rod_rows: list[dict]) -> None:

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..api import SimulationResult, base_summary, finish_summary, open_run_folder
+from ..api import SimulationResult, base_summary, conclude_run, finish_summary, open_run_folder
 from ..geometry.strip import InputError, LoadingProtocol, Strip
 from ..observables import observe
 from .banded import SymmetricBanded
@@ -381,10 +381,4 @@ def simulate_dynamic(
     finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
                    stage=stage, error=error)
     result = DynamicResult(rows, summary, state, model, trace=trace)
-    if folder is not None:
-        folder.finish(result)
-    if interrupted is not None or error is not None:
-        raised = interrupted if interrupted is not None else error
-        raised.result = result
-        raise raised
-    return result
+    return conclude_run(folder, result, interrupted, error)

@@ -82,10 +82,13 @@ def test_run_that_stops_converging_exits_3_and_keeps_the_converged_part(tmp_path
     assert code == 3
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["converged"] is False and "dL/L" in summary["message"] and "dW/L" in summary["message"]
+    assert summary["status"] == "stopped" and summary["path_complete"] is False
     with open(tmp_path / "path.csv") as fh:
         rows = list(csv.DictReader(fh))
     assert 2 <= len(rows) < 1 + 5 + 4 and rows[0]["stage"] == "compression"
-    assert "did not complete" in capsys.readouterr().err
+    assert len(rows) == summary["recorded_steps"]
+    err = capsys.readouterr().err
+    assert "did not complete" in err and err.count("\n") == 1
 
 
 def test_run_that_stops_during_shear_says_how_close_to_dw_max_it_got(tmp_path, monkeypatch):

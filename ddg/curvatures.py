@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .energies.hinge_bending import triangle_normals
-from .energies.rod_curvature import StencilGeometry, material_curvatures
+from .energies.rod_curvature import material_curvatures
 from .geometry.frames import cross, reference_twist, rowdot, unit
 from .geometry.strip import InputError
 from .io import atomic_write_text
@@ -33,8 +33,7 @@ def framed_curve_curvatures(x: np.ndarray, m1: np.ndarray):
     edges carry unit normals m1 (n - 1, 3) perpendicular to them (Eqs. 3-5 with theta = 0)."""
     t = unit(x[1:] - x[:-1])
     m2 = cross(t, m1)
-    geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
-    kappa_n, kappa_g = material_curvatures(geom)
+    kappa_n, kappa_g = material_curvatures(x, m1, m2)
     return kappa_g, kappa_n, reference_twist(m1, t)
 
 
@@ -43,8 +42,7 @@ def rod_curvatures(model, q: np.ndarray) -> dict:
     s/L of the interior nodes and k1 L (geodesic), k2 L (bending), tau L (twist)."""
     x = model.positions(q)
     _, _, m1, m2, m_ref = model.frames(q)
-    geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
-    kappa_n, kappa_g = material_curvatures(geom)
+    kappa_n, kappa_g = material_curvatures(x, m1, m2)
     theta = q[model.theta_dofs]
     tau = theta[1:] - theta[:-1] + m_ref
     L = model.strip.length

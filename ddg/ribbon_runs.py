@@ -309,17 +309,15 @@ def drag_barrier(model, a: State, frames_a, b: State, frames_b, samples: int = 2
 
 
 def _quartic_per_node(model, q):
-    from .energies.rod_curvature import StencilGeometry
-    from .energies.sadowsky import sadowsky_energy
+    from .energies.rod_curvature import material_curvatures
+    from .energies.rod_twist import discrete_twist
+    from .energies.sadowsky import sadowsky_density
 
     x = q[model.node_dofs]
     _, _, m1, m2, m_ref = model.frames(q)
-    geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
-    theta = q[model.theta_dofs]
-    s = model.strip
-    _, parts, _, _ = sadowsky_energy(geom, theta[1:] - theta[:-1] + m_ref, model.voronoi_lengths, s.bending_stiffness,
-                                     s.geodesic_bending_stiffness, s.twisting_stiffness, model.zeta, gradient=False)
-    return parts["sadowsky"]
+    kappa_n, _ = material_curvatures(x, m1, m2)
+    tau = discrete_twist(q[model.theta_dofs], m_ref)
+    return sadowsky_density(kappa_n, tau, model.voronoi_lengths, model.strip.bending_stiffness, model.zeta)[0]
 
 
 def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float | None = None,

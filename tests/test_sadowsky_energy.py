@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 from ddg import Strip
-from ddg.energies.rod_bending import bending_energy
-from ddg.energies.rod_curvature import StencilGeometry, material_curvatures
-from ddg.energies.sadowsky import quartic_twist_term, sadowsky_energy
+from ddg.energies.rod_bending import bending_density
+from ddg.energies.rod_curvature import material_curvatures
+from ddg.energies.rod_twist import discrete_twist, twisting_density
+from ddg.energies.sadowsky import quartic_twist_term, sadowsky_density
 from ddg.geometry.strip import InputError
 from ddg.models.ribbon import RibbonModel
 from ddg.models.rod import RodModel
@@ -51,11 +52,20 @@ def deformed_twisted_state(model, seed: int) -> np.ndarray:
 
 
 def stencil_state(model, q):
+    """Curvatures (kappa_n, kappa_g) and twist tau at q (frames transported from the committed state)."""
     x = model.positions(q)
     _, _, m1, m2, m_ref = model.frames(q)
-    geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
-    theta = q[model.theta_dofs]
-    return geom, theta[1:] - theta[:-1] + m_ref
+    kn, kg = material_curvatures(x, m1, m2)
+    return kn, kg, discrete_twist(q[model.theta_dofs], m_ref)
+
+
+def sadowsky_energy(kn, kg, tau, dl, ei2, ei1, gj, zeta):
+    """Eq. (A.5) per stencil, its parts and its partials in (kappa_n, kappa_g, tau): the rod's
+    densities plus the quartic term, as RibbonModel.stencil_density sums them."""
+    e_b, f_b, s_b = bending_density(kn, kg, dl, ei2, ei1)
+    e_t, f_t, s_t = twisting_density(tau, dl, gj)
+    e_q, f_q, s_q = sadowsky_density(kn, tau, dl, ei2, zeta)
+    return e_b + e_t + e_q, {"bending": e_b, "twisting": e_t, "sadowsky": e_q}, f_b + f_t + f_q, s_b + s_t + s_q
 
 
 def test_quartic_term_partials_match_finite_differences():
@@ -86,8 +96,6 @@ def test_ribbon_gradient_and_hessian_match_finite_differences(seed, zeta_over_l)
     model = RibbonModel(STRIP, 9, zeta=zeta_over_l * STRIP.length)
     q = deformed_twisted_state(model, seed)
     model.commit(q)
-    geom, tau = stencil_state(model, q)
-    kn, _ = material_curvatures(geom)
     # the quartic term is a sizeable share of the energy at these states
     ev = model.evaluate(q)
     assert ev.parts["sadowsky"] > 0.2 * ev.parts["twisting"]
@@ -109,35 +117,53 @@ def test_ribbon_gradient_and_hessian_match_finite_differences(seed, zeta_over_l)
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_zero_twist_reduces_to_the_rod_bending_energy(seed):
-    """With tau = 0 the energy and gradient of Eq. (A.5) equal the rod's bending energy (Eq. 6b),
-    with EI1 = 0 its out-of-plane part alone; the Hessians differ only by the twist's
-    GJ grad(tau) grad(tau)^T (the quartic term has zero Hessian at tau = 0)."""
+    """With tau = 0 the energy and its partials of Eq. (A.5) equal the rod's bending energy (Eq. 6b),
+    with EI1 = 0 its out-of-plane part alone; the second partials differ only by the twist's GJ / dl
+    (the quartic term has zero second derivatives at tau = 0)."""
     model = RodModel(STRIP, 12)
     q = deformed_twisted_state(model, seed)
     model.commit(q)
-    geom, tau = stencil_state(model, q)
+    kn, kg, tau = stencil_state(model, q)
     zero = np.zeros_like(tau)
     dl = model.voronoi_lengths
     s = STRIP
     for ei1 in (s.geodesic_bending_stiffness, 0.0):
-        e_rod, g_rod, h_rod = bending_energy(geom, dl, s.bending_stiffness, ei1)
-        e, parts, g, h = sadowsky_energy(geom, zero, dl, s.bending_stiffness, ei1, s.twisting_stiffness,
-                                         zeta=1e-3 * s.length)
+        e_rod, f_rod, s_rod = bending_density(kn, kg, dl, s.bending_stiffness, ei1)
+        e, parts, f, sec = sadowsky_energy(kn, kg, zero, dl, s.bending_stiffness, ei1, s.twisting_stiffness,
+                                           zeta=1e-3 * s.length)
         assert np.max(np.abs(e - e_rod)) <= 1e-14 * np.max(e_rod)
         assert np.all(parts["sadowsky"] == 0.0) and np.all(parts["twisting"] == 0.0)
-        assert rel_err(g, g_rod) < 1e-13
-        from ddg.energies.rod_twist import twist_derivatives
-
-        g_tau, _ = twist_derivatives(geom)
-        k = s.twisting_stiffness / dl
-        twist_outer = k[:, None, None] * g_tau[:, :, None] * g_tau[:, None, :]
-        assert rel_err(h, h_rod + twist_outer) < 1e-13
+        assert rel_err(f, f_rod) < 1e-13
+        expected = s_rod.copy()
+        expected[:, 2, 2] += s.twisting_stiffness / dl
+        assert rel_err(sec, expected) < 1e-13
     # and at the actual (non-zero) twist the quartic term is what distinguishes the two
-    e, parts, _, _ = sadowsky_energy(geom, tau, dl, s.bending_stiffness, s.geodesic_bending_stiffness,
+    e, parts, _, _ = sadowsky_energy(kn, kg, tau, dl, s.bending_stiffness, s.geodesic_bending_stiffness,
                                      s.twisting_stiffness, zeta=s.length)
-    kn, _ = material_curvatures(geom)
     expected = 0.5 * s.bending_stiffness / dl * tau**4 / (kn**2 + (dl / s.length) ** 2)
     assert parts["sadowsky"] == pytest.approx(expected, rel=1e-13)
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_density_partials_match_finite_differences(seed):
+    """The partials of Eq. (A.5) in (kappa_n, kappa_g, tau) that the compiled chain rule uses:
+    first partials = central differences of the energy, second = of the first."""
+    model = RodModel(STRIP, 12)
+    q = deformed_twisted_state(model, seed)
+    model.commit(q)
+    strains = np.stack(stencil_state(model, q), axis=1)
+    dl = model.voronoi_lengths
+    s = STRIP
+    args = (dl, s.bending_stiffness, s.geodesic_bending_stiffness, s.twisting_stiffness, 0.5 * s.length)
+    _, _, first, second = sadowsky_energy(*strains.T, *args)
+    eps = 1e-7
+    for c in range(3):
+        step = np.zeros_like(strains)
+        step[:, c] = eps
+        ep, _, fp, _ = sadowsky_energy(*(strains + step).T, *args)
+        em, _, fm, _ = sadowsky_energy(*(strains - step).T, *args)
+        assert rel_err((ep - em) / (2 * eps), first[:, c]) < RTOL
+        assert rel_err((fp - fm) / (2 * eps), second[:, :, c]) < RTOL
 
 
 def test_sadowsky_limit_with_gj_equal_2ei2():
@@ -145,13 +171,12 @@ def test_sadowsky_limit_with_gj_equal_2ei2():
     model = RodModel(STRIP, 12)
     q = deformed_twisted_state(model, 1)
     model.commit(q)
-    geom, tau = stencil_state(model, q)
+    kn, kg, tau = stencil_state(model, q)
     dl = model.voronoi_lengths
     s = STRIP
     assert s.twisting_stiffness == pytest.approx(2 * s.bending_stiffness, rel=1e-14)
-    e, _, _, _ = sadowsky_energy(geom, tau, dl, s.bending_stiffness, s.geodesic_bending_stiffness,
+    e, _, _, _ = sadowsky_energy(kn, kg, tau, dl, s.bending_stiffness, s.geodesic_bending_stiffness,
                                  s.twisting_stiffness, zeta=1e12)
-    kn, kg = material_curvatures(geom)
     expected = 0.5 / dl * (s.bending_stiffness * (kn**2 + tau**2) ** 2 / kn**2 + s.geodesic_bending_stiffness * kg**2)
     assert e == pytest.approx(expected, rel=1e-12)
 

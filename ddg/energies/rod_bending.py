@@ -1,35 +1,25 @@
-"""The rod's bending energy, Eq. (6b), vectorised over interior nodes.
+"""The rod's bending energy, Eq. (6b), as a function of the stencil strains.
 
 E_b = 1/2 sum 1/dl_i [EI2 (kappa_n)^2 + EI1 (kappa_g)^2] for a naturally straight strip,
 with kappa_n (out of plane) and kappa_g (geodesic) from rod_curvature; dl_i is the
-undeformed Voronoi length.
+undeformed Voronoi length. The chain rule to the DOFs is rod_curvature.add_stencil_terms.
 """
 from __future__ import annotations
 
+import numpy as np
 
-from .rod_curvature import StencilGeometry, curvature_derivatives
+from .rod_curvature import KAPPA_G, KAPPA_N
 
 
-def bending_energy(g: StencilGeometry, voronoi_lengths, bending_stiffness, geodesic_bending_stiffness,
-                   *, gradient=True, hessian=True):
-    """E_b per node, stencil gradient (n, 11) and symmetric Hessian (n, 11, 11).
-
-    The Hessian is 1/dl [EI2 (grad kn grad kn^T + kn hess kn) + EI1 (same for kg)].
-    """
-    (kn, gn, hn), (kg, gg, hg) = curvature_derivatives(g, hessian=hessian and gradient)
+def bending_density(kappa_n, kappa_g, voronoi_lengths, bending_stiffness, geodesic_bending_stiffness):
+    """E_b per stencil (n,), its partials in (kappa_n, kappa_g, tau) (n, 3) and second partials (n, 3, 3)."""
     a = bending_stiffness / voronoi_lengths
     c = geodesic_bending_stiffness / voronoi_lengths
-    energy = 0.5 * (a * kn**2 + c * kg**2)
-    if not gradient:
-        return energy, None, None
-    grad = (a * kn)[:, None] * gn + (c * kg)[:, None] * gg
-    if not hessian:
-        return energy, grad, None
-    hess = curvature_hessian_terms(hn, hg, a * kn, c * kg)
-    hess += a[:, None, None] * (gn[:, :, None] * gn[:, None, :]) + c[:, None, None] * (gg[:, :, None] * gg[:, None, :])
-    return energy, grad, hess
-
-
-def curvature_hessian_terms(hn, hg, weight_n, weight_g):
-    """weight_n Hess(kappa_n) + weight_g Hess(kappa_g), mapped to the 11x11 stencil."""
-    return hn.scaled_sum([weight_n, weight_g], [hg]).to_stencil()
+    energy = 0.5 * (a * kappa_n**2 + c * kappa_g**2)
+    first = np.zeros((len(energy), 3))
+    first[:, KAPPA_N] = a * kappa_n
+    first[:, KAPPA_G] = c * kappa_g
+    second = np.zeros((len(energy), 3, 3))
+    second[:, KAPPA_N, KAPPA_N] = a
+    second[:, KAPPA_G, KAPPA_G] = c
+    return energy, first, second

@@ -1,4 +1,4 @@
-"""Discrete material curvatures of a framed centerline and their derivatives (Eqs. 3-4).
+"""The rod's discrete strains at an interior node and their derivatives (Eqs. 3-5), compiled.
 
 At interior node i, with incoming edge e = x_i - x_{i-1} and outgoing edge f = x_{i+1} - x_i,
 the curvature binormal is kb = 2 e x f / (|e||f| + e.f) (Eq. 3) and the two material
@@ -12,6 +12,9 @@ m1 the surface normal and pairing kappa^(1) with the stiff E b W^3 / 12; those t
 statements cannot all hold. We keep m1 as the normal and pair each curvature with the
 stiffness of the bending it measures: kappa_n (the paper's kappa^(2), out of plane) with
 EI2 = E W b^3 / 12 and kappa_g (the paper's kappa^(1), geodesic) with EI1 = E b W^3 / 12.
+The third strain is the discrete twist tau = theta^i - theta^{i-1} + m_ref (Eq. 5), with
+d m_ref / de = kb / (2 |e|) and d m_ref / df = kb / (2 |f|) for reference frames carried by
+parallel transport in time (Bergou et al. 2010).
 
 Local DOF order of a stencil (11 entries, contiguous in the rod's DOF vector of Eq. 1):
     [x_{i-1} (0:3), theta^{i-1} (3), x_i (4:7), theta^i (7), x_{i+1} (8:11)].
@@ -19,191 +22,302 @@ Derivatives are those of the energy with reference frames carried by parallel tr
 time from the current configuration (Bergou et al. 2010; Jawed et al. 2018 primer); the
 Hessian is the symmetric part of the derivative of the gradient, which is the exact second
 derivative along straight lines in DOF space.
+
+Every rod-type energy (the rod's bending Eq. 6b and twisting Eq. 6c, the Sadowsky ribbon
+Eq. A.5) is a function of these three strains per stencil, E_i = e(kappa_n, kappa_g, tau): its
+module gives the partial derivatives of e, and `add_stencil_terms` applies the chain rule,
+
+    grad E_i = sum_c e_c grad s_c,   hess E_i = sum_c e_c hess s_c + sum_cd e_cd grad s_c grad s_d^T,
+
+in one compiled pass that writes straight into the assembled gradient and band. This module is
+the only implementation of the strains and their derivatives.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
-from ..geometry.frames import cross, rowdot
+from ..solve.band_scatter import add_symmetric_block
 
-# positions of the blocks in the 11-DOF stencil
-XE, TE, XI, TF, XF = slice(0, 3), 3, slice(4, 7), 7, slice(8, 11)
-_NODE = (slice(0, 3), slice(4, 7), slice(8, 11))
-# d(edge)/d(node): e = x_i - x_{i-1}, f = x_{i+1} - x_i
-_EDGE_SIGN = np.array([[-1.0, 0.0], [1.0, -1.0], [0.0, 1.0]])
-
-
-_EYE = np.eye(3)
+#: Strain order in every (n, 3) array of this module: out-of-plane curvature, geodesic curvature, twist.
+KAPPA_N, KAPPA_G, TAU = 0, 1, 2
+STENCIL_SIZE = 11
 
 
-def _outer(a, b):
-    """Row-wise outer products (..., 3) x (..., 3) -> (..., 3, 3)."""
-    return a[..., :, None] * b[..., None, :]
+@njit(cache=True, inline="always")
+def _cross(a, b, out):
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
 
 
-def _swap(m):
-    return np.swapaxes(m, -1, -2)
+@njit(cache=True, inline="always")
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-def _skew(v):
-    """Cross-product matrices [v]x of row vectors (..., 3) -> (..., 3, 3)."""
-    out = np.zeros(v.shape + (3,))
-    out[..., 0, 1] = -v[..., 2]
-    out[..., 0, 2] = v[..., 1]
-    out[..., 1, 0] = v[..., 2]
-    out[..., 1, 2] = -v[..., 0]
-    out[..., 2, 0] = -v[..., 1]
-    out[..., 2, 1] = v[..., 0]
+@njit(cache=True)
+def _stencil(xp, xi, xn, m1e, m2e, m1f, m2f, strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w):
+    """Curvatures (strain[0:2]) and the edge-form derivatives of (kappa_n, kappa_g, tau) of one
+    stencil: ge, gf (3 strains, 3) = d/de, d/df; gth (3, 2) = d/dtheta^{e,f}; hee, hef, hff
+    (3, 3, 3) second derivatives in e and f; heth, hfth (3, 3, 2) mixed; hthth (3, 2) twist
+    diagonal. w: scratch (16, 3)."""
+    e, f, te, tf, kb, tt, dt, tfc, tec, ga_e, ga_f, mm_e, mm_f, ds, tmp, ae = (
+        w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9], w[10], w[11], w[12], w[13], w[14], w[15])
+    for k in range(3):
+        e[k] = xi[k] - xp[k]
+        f[k] = xn[k] - xi[k]
+    ne = math.sqrt(_dot(e, e))
+    nf = math.sqrt(_dot(f, f))
+    ie, jf = 1.0 / ne, 1.0 / nf
+    for k in range(3):
+        te[k] = e[k] * ie
+        tf[k] = f[k] * jf
+    chi = 1.0 + _dot(te, tf)
+    _cross(te, tf, kb)
+    for k in range(3):
+        kb[k] *= 2.0 / chi
+        tt[k] = (te[k] + tf[k]) / chi
+    ie2, jf2, iej = ie * ie, jf * jf, ie * jf
+    for c in range(2):
+        sgn = 1.0 if c == 0 else -1.0
+        for k in range(3):
+            if c == 0:  # kappa_n: director m2, twist directors m1 (d m2/d theta = -m1), kb (x) m2 terms
+                ds[k] = m2e[k] + m2f[k]
+                ga_e[k], ga_f[k] = m1e[k], m1f[k]
+                mm_e[k], mm_f[k] = m2e[k], m2f[k]
+            else:  # kappa_g: director m1, twist directors m2
+                ds[k] = m1e[k] + m1f[k]
+                ga_e[k], ga_f[k] = m2e[k], m2f[k]
+                mm_e[k], mm_f[k] = m1e[k], m1f[k]
+            dt[k] = ds[k] / chi
+        kappa = sgn * 0.5 * _dot(kb, ds)
+        strain[c] = kappa
+        _cross(tf, dt, tfc)
+        _cross(te, dt, tec)
+        for k in range(3):
+            ge[c, k] = ie * (-kappa * tt[k] + sgn * tfc[k])
+            gf[c, k] = jf * (-kappa * tt[k] - sgn * tec[k])
+        kb_ga_e, kb_ga_f = _dot(kb, ga_e), _dot(kb, ga_f)
+        gth[c, 0] = -0.5 * kb_ga_e
+        gth[c, 1] = -0.5 * kb_ga_f
+        for a in range(3):
+            for b in range(3):
+                eye = 1.0 if a == b else 0.0
+                tt2 = 2.0 * kappa * tt[a] * tt[b]
+                hee[c, a, b] = ie2 * (tt2 - sgn * (tfc[a] * tt[b] + tt[a] * tfc[b])
+                                      - kappa / chi * (eye - te[a] * te[b])
+                                      + 0.25 * sgn * (kb[a] * mm_e[b] + mm_e[a] * kb[b]))
+                hff[c, a, b] = jf2 * (tt2 + sgn * (tec[a] * tt[b] + tt[a] * tec[b])
+                                      - kappa / chi * (eye - tf[a] * tf[b])
+                                      + 0.25 * sgn * (kb[a] * mm_f[b] + mm_f[a] * kb[b]))
+                hef[c, a, b] = iej * (-kappa / chi * (eye + te[a] * tf[b]) + tt2
+                                      + sgn * (tt[a] * tec[b] - tfc[a] * tt[b]))
+        # - sgn [dt]x on the e-f block
+        hef[c, 0, 1] += iej * sgn * dt[2]
+        hef[c, 0, 2] -= iej * sgn * dt[1]
+        hef[c, 1, 0] -= iej * sgn * dt[2]
+        hef[c, 1, 2] += iej * sgn * dt[0]
+        hef[c, 2, 0] += iej * sgn * dt[1]
+        hef[c, 2, 1] -= iej * sgn * dt[0]
+        for j in range(2):
+            ga = ga_e if j == 0 else ga_f
+            kb_ga = kb_ga_e if j == 0 else kb_ga_f
+            _cross(tf, ga, tmp)
+            for k in range(3):
+                heth[c, k, j] = ie * (0.5 * kb_ga * tt[k] - tmp[k] / chi)
+            _cross(te, ga, tmp)
+            for k in range(3):
+                hfth[c, k, j] = jf * (0.5 * kb_ga * tt[k] + tmp[k] / chi)
+        hthth[c, 0] = -sgn * 0.5 * _dot(kb, mm_e)
+        hthth[c, 1] = -sgn * 0.5 * _dot(kb, mm_f)
+    # twist: tau = theta^f - theta^e + m_ref, linear in theta
+    for k in range(3):
+        ge[2, k] = 0.5 * kb[k] * ie
+        gf[2, k] = 0.5 * kb[k] * jf
+        ae[k] = te[k] + tt[k]
+        tmp[k] = tf[k] + tt[k]
+    gth[2, 0], gth[2, 1] = -1.0, 1.0
+    for a in range(3):
+        for b in range(3):
+            hee[2, a, b] = -0.25 * ie2 * (kb[a] * ae[b] + ae[a] * kb[b])
+            hff[2, a, b] = -0.25 * jf2 * (kb[a] * tmp[b] + tmp[a] * kb[b])
+            hef[2, a, b] = -0.25 * iej * (kb[a] * tt[b] + tt[a] * kb[b])
+    # + 1/2 ([te]x + [tf]x) / chi / (|e||f|)
+    s0, s1, s2 = (te[0] + tf[0]) * 0.5 * iej / chi, (te[1] + tf[1]) * 0.5 * iej / chi, (te[2] + tf[2]) * 0.5 * iej / chi
+    hef[2, 0, 1] -= s2
+    hef[2, 0, 2] += s1
+    hef[2, 1, 0] += s2
+    hef[2, 1, 2] -= s0
+    hef[2, 2, 0] -= s1
+    hef[2, 2, 1] += s0
+    for k in range(3):
+        for j in range(2):
+            heth[2, k, j] = 0.0
+            hfth[2, k, j] = 0.0
+    hthth[2, 0], hthth[2, 1] = 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _stencil_gradient(ge, gf, gth, c, out):
+    """The 11-entry stencil gradient of strain c from its edge form (e = x_i - x_{i-1}, f = x_{i+1} - x_i)."""
+    for k in range(3):
+        out[k] = -ge[c, k]
+        out[4 + k] = ge[c, k] - gf[c, k]
+        out[8 + k] = gf[c, k]
+    out[3] = gth[c, 0]
+    out[7] = gth[c, 1]
+
+
+@njit(cache=True)
+def _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, out):
+    """The (11, 11) stencil Hessian of an edge-form second derivative (blocks in e, f, theta)."""
+    for a in range(3):
+        for b in range(3):
+            EE, EF, FE, FF = ee[a, b], ef[a, b], ef[b, a], ff[a, b]
+            out[a, b] = EE
+            out[a, 4 + b] = EF - EE
+            out[a, 8 + b] = -EF
+            out[4 + a, b] = FE - EE
+            out[4 + a, 4 + b] = EE - EF - FE + FF
+            out[4 + a, 8 + b] = EF - FF
+            out[8 + a, b] = -FE
+            out[8 + a, 4 + b] = FE - FF
+            out[8 + a, 8 + b] = FF
+    for j in range(2):
+        col = 3 if j == 0 else 7
+        for a in range(3):
+            e_t, f_t = eth[a, j], fth[a, j]
+            out[a, col] = out[col, a] = -e_t
+            out[4 + a, col] = out[col, 4 + a] = e_t - f_t
+            out[8 + a, col] = out[col, 8 + a] = f_t
+    out[3, 3], out[7, 7] = thth[0], thth[1]
+    out[3, 7] = out[7, 3] = 0.0
+
+
+@njit(cache=True)
+def _scratch():
+    """Work arrays of one stencil (allocated inside the compiled loops: a tuple of arrays passed
+    in from Python costs ~90 microseconds of dispatch per call)."""
+    return (np.empty(3), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 2)), np.empty((3, 3, 3)),
+            np.empty((3, 3, 3)), np.empty((3, 3, 3)), np.empty((3, 3, 2)), np.empty((3, 3, 2)), np.empty((3, 2)),
+            np.empty((16, 3)))
+
+
+@njit(cache=True)
+def _curvatures(x, m1, m2):
+    n = x.shape[0] - 2
+    out = np.empty((n, 2))
+    kb = np.empty(3)
+    for i in range(n):
+        e0, e1, e2 = x[i + 1, 0] - x[i, 0], x[i + 1, 1] - x[i, 1], x[i + 1, 2] - x[i, 2]
+        f0, f1, f2 = x[i + 2, 0] - x[i + 1, 0], x[i + 2, 1] - x[i + 1, 1], x[i + 2, 2] - x[i + 1, 2]
+        ne, nf = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2), math.sqrt(f0 * f0 + f1 * f1 + f2 * f2)
+        scale = 2.0 / (ne * nf + e0 * f0 + e1 * f1 + e2 * f2)
+        kb[0] = scale * (e1 * f2 - e2 * f1)
+        kb[1] = scale * (e2 * f0 - e0 * f2)
+        kb[2] = scale * (e0 * f1 - e1 * f0)
+        kn = 0.0
+        kg = 0.0
+        for k in range(3):
+            kn += kb[k] * (m2[i, k] + m2[i + 1, k])
+            kg -= kb[k] * (m1[i, k] + m1[i + 1, k])
+        out[i, 0] = 0.5 * kn
+        out[i, 1] = 0.5 * kg
     return out
 
 
-def _scatter_edges(grad_e, grad_f, out):
-    """Write d/de, d/df (n, 3) into the node blocks of an (n, 11) stencil gradient."""
-    out[:, XE] = -grad_e
-    out[:, XI] = grad_e - grad_f
-    out[:, XF] = grad_f
+def material_curvatures(x: np.ndarray, m1: np.ndarray, m2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(kappa_n, kappa_g) at the M - 2 interior nodes of a centerline x (M, 3) with material
+    directors m1, m2 (M - 1, 3) (Eq. 4); integrated, dimensionless (2 tan of half the turning angle)."""
+    k = _curvatures(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(m1, dtype=float),
+                    np.ascontiguousarray(m2, dtype=float))
+    return k[:, 0].copy(), k[:, 1].copy()
 
 
-class StencilHessian:
-    """Second derivatives of a stencil quantity in edge form, before mapping to the 11 DOFs.
-
-    ee, ef, ff: (n, 3, 3) blocks d2/de2, d2/de df, d2/df2; e_theta, f_theta: (n, 3, 2)
-    mixed blocks with (theta^{i-1}, theta^i); theta_theta: (n, 2) diagonal twist block.
-    Linear combinations are formed in this compact form and mapped to (n, 11, 11) once.
-    """
-
-    __slots__ = ("ee", "ef", "ff", "e_theta", "f_theta", "theta_theta")
-
-    def __init__(self, ee, ef, ff, e_theta, f_theta, theta_theta):
-        self.ee, self.ef, self.ff = ee, ef, ff
-        self.e_theta, self.f_theta, self.theta_theta = e_theta, f_theta, theta_theta
-
-    def scaled_sum(self, weights, others=()):
-        """sum_k w_k H_k with weights (n,) arrays: self * weights[0] + others[k] * weights[k+1]."""
-        terms = [(self, weights[0])] + [(h, w) for h, w in zip(others, weights[1:])]
-        out = []
-        for name in self.__slots__:
-            acc = 0.0
-            for h, w in terms:
-                value = getattr(h, name)
-                if value is None:
-                    continue
-                acc = acc + w.reshape((-1,) + (1,) * (value.ndim - 1)) * value
-            out.append(acc)
-        return StencilHessian(*out)
-
-    def to_stencil(self) -> np.ndarray:
-        """The (n, 11, 11) Hessian in stencil DOF order (e = x_i - x_{i-1}, f = x_{i+1} - x_i)."""
-        n = self.ee.shape[0]
-        ee, ef, ff = self.ee, self.ef, self.ff
-        fe = ef.transpose(0, 2, 1)
-        hess = np.empty((n, 11, 11))
-        hess[:, XE, XE] = ee
-        hess[:, XE, XI] = ef - ee
-        hess[:, XE, XF] = -ef
-        hess[:, XI, XE] = fe - ee
-        hess[:, XI, XI] = ee - ef - fe + ff
-        hess[:, XI, XF] = ef - ff
-        hess[:, XF, XE] = -fe
-        hess[:, XF, XI] = fe - ff
-        hess[:, XF, XF] = ff
-        for col, c in ((TE, 0), (TF, 1)):
-            e_t, f_t = self.e_theta[:, :, c], self.f_theta[:, :, c]
-            hess[:, XE, col] = -e_t
-            hess[:, XI, col] = e_t - f_t
-            hess[:, XF, col] = f_t
-            hess[:, col, XE] = -e_t
-            hess[:, col, XI] = e_t - f_t
-            hess[:, col, XF] = f_t
-        hess[:, TE, TE] = self.theta_theta[:, 0]
-        hess[:, TF, TF] = self.theta_theta[:, 1]
-        hess[:, TE, TF] = 0.0
-        hess[:, TF, TE] = 0.0
-        return hess
+def turning_chi(x: np.ndarray) -> np.ndarray:
+    """chi = 1 + t^e . t^f at the interior nodes (2 for a straight node, 0 for a reversal)."""
+    t = np.diff(x, axis=0)
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    return 1.0 + np.einsum("ij,ij->i", t[:-1], t[1:])
 
 
-class StencilGeometry:
-    """Per-node quantities shared by the bending and twisting energies (vectorised)."""
-
-    def __init__(self, x_prev, x_node, x_next, m1e, m2e, m1f, m2f):
-        self.e = x_node - x_prev
-        self.f = x_next - x_node
-        self.norm_e = np.sqrt(rowdot(self.e, self.e))
-        self.norm_f = np.sqrt(rowdot(self.f, self.f))
-        self.te = self.e / self.norm_e[:, None]
-        self.tf = self.f / self.norm_f[:, None]
-        self.chi = 1.0 + rowdot(self.te, self.tf)
-        self.kb = 2.0 * cross(self.te, self.tf) / self.chi[:, None]
-        self.tilde_t = (self.te + self.tf) / self.chi[:, None]
-        self.m1e, self.m2e, self.m1f, self.m2f = m1e, m2e, m1f, m2f
+@njit(cache=True)
+def _derivatives(x, m1, m2, strains, grads, hessians):
+    strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w = _scratch()
+    for i in range(x.shape[0] - 2):
+        _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1],
+                 strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w)
+        strains[i, 0], strains[i, 1] = strain[0], strain[1]
+        for c in range(3):
+            _stencil_gradient(ge, gf, gth, c, grads[i, c])
+            _edge_form_to_stencil(hee[c], hef[c], hff[c], heth[c], hfth[c], hthth[c], hessians[i, c])
 
 
-def material_curvatures(g: StencilGeometry) -> tuple[np.ndarray, np.ndarray]:
-    """(kappa_n, kappa_g) at each interior node, Eq. (4)."""
-    kappa_n = 0.5 * rowdot(g.kb, g.m2e + g.m2f)
-    kappa_g = -0.5 * rowdot(g.kb, g.m1e + g.m1f)
-    return kappa_n, kappa_g
+def strain_derivatives(x: np.ndarray, m1: np.ndarray, m2: np.ndarray):
+    """(kappa_n, kappa_g) (n, 2), stencil gradients (n, 3, 11) and Hessians (n, 3, 11, 11) of the
+    three strains (kappa_n, kappa_g, tau) at the n = M - 2 interior nodes. The twist's value needs
+    the twist angles and m_ref (rod_twist.discrete_twist); its derivatives need only the geometry.
+    For tests and analysis: the models assemble with `add_stencil_terms` without forming these."""
+    n = x.shape[0] - 2
+    strains = np.empty((n, 2))
+    grads = np.empty((n, 3, STENCIL_SIZE))
+    hessians = np.empty((n, 3, STENCIL_SIZE, STENCIL_SIZE))
+    _derivatives(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(m1, dtype=float),
+                 np.ascontiguousarray(m2, dtype=float), strains, grads, hessians)
+    return strains, grads, hessians
 
 
-def curvature_derivatives(g: StencilGeometry, hessian: bool = True):
-    """[(kappa, gradient (n, 11), StencilHessian)] for kappa_n and kappa_g.
+@njit(cache=True)
+def add_stencil_terms(x, m1, m2, first, second, first_offset, n_dof, grad, band, want_hessian):
+    """Chain rule for an energy sum_i e(kappa_n, kappa_g, tau) of the stencils: adds its gradient
+    to grad and (want_hessian) its Hessian to the flattened lower band of an n_dof matrix.
 
-    The two curvatures differ only in the director (d2~ for kappa_n, d1~ for kappa_g), the
-    directors in their twist derivatives and a few signs; both are computed at once on arrays
-    with a leading axis of length 2, which halves the number of numpy calls.
-    """
-    n = g.e.shape[0]
-    kappa = np.stack(material_curvatures(g))                              # (2, n)
-    chi = g.chi
-    inv_e = 1.0 / g.norm_e
-    inv_f = 1.0 / g.norm_f
-    tt = g.tilde_t
-    dt = np.stack([g.m2e + g.m2f, g.m1e + g.m1f]) / chi[None, :, None]  # (2, n, 3)
-    sgn = np.array([1.0, -1.0])[:, None, None]
-    # directors of d kappa / d theta^{e,f}: (curvature, edge, n, 3); d m1/dtheta = m2, d m2/dtheta = -m1
-    ga = np.stack([np.stack([g.m1e, g.m1f]), np.stack([g.m2e, g.m2f])])
-    # directors of the kb (x) m terms and of d2 kappa / d theta2: (curvature, edge, n, 3)
-    mm = np.stack([np.stack([g.m2e, g.m2f]), np.stack([g.m1e, g.m1f])])
-    k1 = kappa[:, :, None]
-    tf_c = cross(g.tf, dt)
-    te_c = cross(g.te, dt)
-    grad = np.zeros((2, n, 11))
-    dke = inv_e[:, None] * (-k1 * tt + sgn * tf_c)
-    dkf = inv_f[:, None] * (-k1 * tt - sgn * te_c)
-    grad[:, :, XE] = -dke
-    grad[:, :, XI] = dke - dkf
-    grad[:, :, XF] = dkf
-    kb_ga = rowdot(g.kb, ga)                                               # (2, 2, n)
-    grad[:, :, TE] = -0.5 * kb_ga[:, 0]
-    grad[:, :, TF] = -0.5 * kb_ga[:, 1]
-    if not hessian:
-        return [(kappa[c], grad[c], None) for c in range(2)]
-    k3 = kappa[:, :, None, None]
-    chi3 = chi[:, None, None]
-    tt_tt = _outer(tt, tt)
-    inv_e2 = (inv_e**2)[:, None, None]
-    inv_f2 = (inv_f**2)[:, None, None]
-    kb_me = _outer(g.kb, mm[:, 0])
-    kb_mf = _outer(g.kb, mm[:, 1])
-    tfc_tt = _outer(tf_c, tt)
-    tec_tt = _outer(te_c, tt)
-    h_ee = inv_e2 * (2.0 * k3 * tt_tt - sgn[..., None] * (tfc_tt + _swap(tfc_tt))
-                     - k3 / chi3 * (_EYE - _outer(g.te, g.te))
-                     + 0.25 * sgn[..., None] * (kb_me + _swap(kb_me)))
-    h_ff = inv_f2 * (2.0 * k3 * tt_tt + sgn[..., None] * (tec_tt + _swap(tec_tt))
-                     - k3 / chi3 * (_EYE - _outer(g.tf, g.tf))
-                     + 0.25 * sgn[..., None] * (kb_mf + _swap(kb_mf)))
-    h_ef = (inv_e * inv_f)[:, None, None] * (
-        -k3 / chi3 * (_EYE + _outer(g.te, g.tf))
-        + 2.0 * k3 * tt_tt + sgn[..., None] * (_swap(tec_tt) - tfc_tt - _skew(dt))
-    )
-    # position-twist blocks d2 kappa / de dtheta, d2 kappa / df dtheta: (2, n, 3, edge)
-    half_kb_tt = 0.5 * kb_ga[..., None] * tt                              # (2, 2, n, 3)
-    chi4 = chi[:, None]
-    e_theta = inv_e[:, None] * (half_kb_tt - cross(g.tf, ga) / chi4)
-    f_theta = inv_f[:, None] * (half_kb_tt + cross(g.te, ga) / chi4)
-    e_theta = np.moveaxis(e_theta, 1, -1)
-    f_theta = np.moveaxis(f_theta, 1, -1)
-    theta_theta = -sgn * 0.5 * np.moveaxis(rowdot(g.kb, mm), 1, -1)  # (2, n, 2)
-    return [(kappa[c], grad[c], StencilHessian(h_ee[c], h_ef[c], h_ff[c], e_theta[c], f_theta[c], theta_theta[c]))
-            for c in range(2)]
+    first (n, 3): de/ds_c per stencil; second (n, 3, 3): d2e/ds_c ds_d; stencil i starts at DOF
+    first_offset + 4 i (the rod's layout, Eq. 1)."""
+    strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w = _scratch()
+    g11 = np.empty((3, STENCIL_SIZE))
+    h11 = np.empty((STENCIL_SIZE, STENCIL_SIZE))
+    ee = np.empty((3, 3))
+    ef = np.empty((3, 3))
+    ff = np.empty((3, 3))
+    eth = np.empty((3, 2))
+    fth = np.empty((3, 2))
+    thth = np.empty(2)
+    dofs = np.empty(STENCIL_SIZE, dtype=np.int64)
+    for i in range(x.shape[0] - 2):
+        _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1],
+                 strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w)
+        base = first_offset + 4 * i
+        for c in range(3):
+            _stencil_gradient(ge, gf, gth, c, g11[c])
+        for a in range(STENCIL_SIZE):
+            grad[base + a] += first[i, 0] * g11[0, a] + first[i, 1] * g11[1, a] + first[i, 2] * g11[2, a]
+        if not want_hessian:
+            continue
+        w0, w1, w2 = first[i, 0], first[i, 1], first[i, 2]
+        for a in range(3):
+            for b in range(3):
+                ee[a, b] = w0 * hee[0, a, b] + w1 * hee[1, a, b] + w2 * hee[2, a, b]
+                ef[a, b] = w0 * hef[0, a, b] + w1 * hef[1, a, b] + w2 * hef[2, a, b]
+                ff[a, b] = w0 * hff[0, a, b] + w1 * hff[1, a, b] + w2 * hff[2, a, b]
+            for j in range(2):
+                eth[a, j] = w0 * heth[0, a, j] + w1 * heth[1, a, j] + w2 * heth[2, a, j]
+                fth[a, j] = w0 * hfth[0, a, j] + w1 * hfth[1, a, j] + w2 * hfth[2, a, j]
+        for j in range(2):
+            thth[j] = w0 * hthth[0, j] + w1 * hthth[1, j] + w2 * hthth[2, j]
+        _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, h11)
+        for c in range(3):
+            for d in range(3):
+                coefficient = second[i, c, d]
+                if coefficient != 0.0:
+                    for a in range(STENCIL_SIZE):
+                        ga = coefficient * g11[c, a]
+                        for b in range(STENCIL_SIZE):
+                            h11[a, b] += ga * g11[d, b]
+        for a in range(STENCIL_SIZE):
+            dofs[a] = base + a
+        add_symmetric_block(band, n_dof, dofs, h11)
+

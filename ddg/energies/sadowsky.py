@@ -21,8 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry.strip import InputError
-from .rod_curvature import StencilGeometry, curvature_derivatives
-from .rod_twist import twist_derivatives
+from .rod_curvature import KAPPA_N, TAU
 
 
 ZETA_RANGE = (1e-9, 1e15)
@@ -60,40 +59,20 @@ def quartic_twist_term(kappa_n, tau, regularisation):
     return q, q_k, q_t, q_kk, q_kt, q_tt
 
 
-def sadowsky_energy(g: StencilGeometry, tau, voronoi_lengths, bending_stiffness, geodesic_bending_stiffness,
-                    twisting_stiffness, zeta, *, gradient=True, hessian=True):
-    """Per-stencil energy of Eq. (A.5), its parts, the (n, 11) gradient and (n, 11, 11) Hessian.
-
-    Returns (energy, parts, grad, hess); parts is a dict of per-stencil arrays 'bending'
-    (EI2 kn^2 + EI1 kg^2), 'twisting' (GJ tau^2) and 'sadowsky' (the quartic term), each with
-    its 1/(2 dl). tau: the discrete twist (Eq. 5) of each stencil; stiffnesses in N m^2.
-    """
+def sadowsky_density(kappa_n, tau, voronoi_lengths, bending_stiffness, zeta):
+    """The quartic term of Eq. (A.5) per stencil, EI2 tau^4 / (kn^2 + (dl / zeta)^2) / (2 dl): its
+    values (n,), partials in (kappa_n, kappa_g, tau) (n, 3) and second partials (n, 3, 3). Added to
+    the rod's bending and twisting densities (rod_bending, rod_twist) it is the whole of Eq. (A.5);
+    the chain rule to the DOFs is rod_curvature.add_stencil_terms."""
     zeta = check_zeta(zeta)
-    want_hessian = hessian and gradient
-    (kn, gn, hn), (kg, gg, hg) = curvature_derivatives(g, hessian=want_hessian)
     a = bending_stiffness / voronoi_lengths
-    c = geodesic_bending_stiffness / voronoi_lengths
-    k = twisting_stiffness / voronoi_lengths
-    q, q_k, q_t, q_kk, q_kt, q_tt = quartic_twist_term(kn, tau, voronoi_lengths / zeta)
-    parts = {"bending": 0.5 * (a * kn**2 + c * kg**2), "twisting": 0.5 * k * tau**2, "sadowsky": 0.5 * a * q}
-    energy = parts["bending"] + parts["twisting"] + parts["sadowsky"]
-    if not gradient:
-        return energy, parts, None, None
-    g_tau, h_tau = twist_derivatives(g, hessian=want_hessian)
-    # first derivatives of E_i with respect to kn, kg and tau
-    e_k = a * (kn + 0.5 * q_k)
-    e_g = c * kg
-    e_t = k * tau + 0.5 * a * q_t
-    grad = e_k[:, None] * gn + e_g[:, None] * gg + e_t[:, None] * g_tau
-    if not want_hessian:
-        return energy, parts, grad, None
-    hess = hn.scaled_sum([e_k, e_g, e_t], [hg, h_tau]).to_stencil()
-    e_kk = a * (1.0 + 0.5 * q_kk)
-    e_kt = 0.5 * a * q_kt
-    e_tt = k + 0.5 * a * q_tt
-    outer = lambda u, v: u[:, :, None] * v[:, None, :]  # noqa: E731
-    cross_kt = outer(gn, g_tau)
-    hess += (e_kk[:, None, None] * outer(gn, gn) + c[:, None, None] * outer(gg, gg)
-             + e_tt[:, None, None] * outer(g_tau, g_tau)
-             + e_kt[:, None, None] * (cross_kt + np.swapaxes(cross_kt, 1, 2)))
-    return energy, parts, grad, hess
+    q, q_k, q_t, q_kk, q_kt, q_tt = quartic_twist_term(kappa_n, tau, voronoi_lengths / zeta)
+    energy = 0.5 * a * q
+    first = np.zeros((len(energy), 3))
+    first[:, KAPPA_N] = 0.5 * a * q_k
+    first[:, TAU] = 0.5 * a * q_t
+    second = np.zeros((len(energy), 3, 3))
+    second[:, KAPPA_N, KAPPA_N] = 0.5 * a * q_kk
+    second[:, KAPPA_N, TAU] = second[:, TAU, KAPPA_N] = 0.5 * a * q_kt
+    second[:, TAU, TAU] = 0.5 * a * q_tt
+    return energy, first, second

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..energies.sadowsky import check_zeta, sadowsky_energy
+from ..energies.sadowsky import check_zeta, sadowsky_density
 from ..geometry.strip import Strip
 from .rod import RodModel
 
@@ -40,10 +40,8 @@ class RibbonModel(RodModel):
         super().__init__(strip, nodes)
         self.zeta = check_zeta(DEFAULT_ZETA_OVER_L * strip.length if zeta is None else zeta)
 
-    def curvature_energy(self, geom, tau: np.ndarray, gradient: bool, hessian: bool):
-        """The Sadowsky energy (Eq. A.5) in place of the rod's bending and twisting."""
-        s = self.strip
-        _, parts, g_r, h_r = sadowsky_energy(geom, tau, self.voronoi_lengths, s.bending_stiffness,
-                                             s.geodesic_bending_stiffness, s.twisting_stiffness, self.zeta,
-                                             gradient=gradient, hessian=hessian)
-        return {k: float(v.sum()) for k, v in parts.items()}, g_r, h_r
+    def stencil_density(self, kappa_n: np.ndarray, kappa_g: np.ndarray, tau: np.ndarray):
+        """The Sadowsky energy (Eq. A.5): the rod's bending and twisting plus the quartic term."""
+        parts, first, second = super().stencil_density(kappa_n, kappa_g, tau)
+        e_q, f_q, s_q = sadowsky_density(kappa_n, tau, self.voronoi_lengths, self.strip.bending_stiffness, self.zeta)
+        return {**parts, "sadowsky": float(e_q.sum())}, first + f_q, second + s_q

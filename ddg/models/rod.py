@@ -12,14 +12,14 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
-from ..energies.rod_bending import bending_energy
-from ..energies.rod_curvature import StencilGeometry, curvature_derivatives
-from ..energies.rod_twist import twist_derivatives, twisting_energy
-from ..energies.stretch import stretching_energy, two_node_blocks
+from ..energies.rod_bending import bending_density
+from ..energies.rod_curvature import add_stencil_terms, material_curvatures
+from ..energies.rod_twist import discrete_twist, twisting_density
+from ..energies.stretch import add_edge_terms
 from ..geometry.centerline import Centerline
-from ..geometry.frames import material_frame, parallel_transport, reference_twist
+from ..geometry.frames import rod_frames
 from ..geometry.strip import Strip
-from ..solve.banded import BandAssembler
+from ..solve.banded import SymmetricBanded
 from .base import BandedModel, Evaluation
 
 __all__ = ["RodModel", "Evaluation"]
@@ -47,11 +47,7 @@ class RodModel(BandedModel):
         self.stretch_stiffness = strip.stretching_stiffness / self.rest_edge_lengths  # Eq. (6a)
         self.constrained = np.r_[np.arange(CLAMPED_DOFS_PER_END), np.arange(self.n_dof - CLAMPED_DOFS_PER_END, self.n_dof)]
         self.free = slice(CLAMPED_DOFS_PER_END, self.n_dof - CLAMPED_DOFS_PER_END)
-        self._assembler = BandAssembler(self.n_dof, self.bandwidth)
-        self._stretch_family = self._assembler.add_family(4 * np.arange(m - 1), 7)
-        self._stencil_family = self._assembler.add_family(4 * np.arange(m - 2), 11)
-        self._stencil_index = 4 * np.arange(m - 2)[:, None] + np.arange(11)[None, :]
-        self._edge_index = 4 * np.arange(m - 1)[:, None] + np.r_[0, 1, 2, 4, 5, 6][None, :]
+        self._edge_nodes = np.stack([np.arange(m - 1), np.arange(1, m)], axis=1)
         self.reset()
 
     # ------------------------------------------------------------------ state
@@ -73,13 +69,7 @@ class RodModel(BandedModel):
 
     def frames(self, q: np.ndarray):
         """Tangents, reference d1 (transported in time from the committed state), m1, m2, m_ref."""
-        x = q[self.node_dofs]
-        edges = x[1:] - x[:-1]
-        t = edges / np.linalg.norm(edges, axis=1)[:, None]
-        d1 = parallel_transport(self._d1, self._tangents, t)
-        m1, m2 = material_frame(d1, t, q[self.theta_dofs])
-        m_ref = reference_twist(d1, t, self._ref_twist)
-        return t, d1, m1, m2, m_ref
+        return rod_frames(q[self.node_dofs], self._tangents, self._d1, q[self.theta_dofs], self._ref_twist)
 
     def commit(self, q: np.ndarray, evaluation: Evaluation | None = None) -> None:
         """Adopt q's frames as the reference from which the next trial states are transported."""
@@ -145,66 +135,39 @@ class RodModel(BandedModel):
 
     # ------------------------------------------------------------------ energy
     def evaluate(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
+        """Energy (Eq. 6), gradient and banded Hessian at q, frames transported from the committed
+        state: compiled passes over the edges (Eq. 6a) and the stencils (Eqs. 6b, 6c, or the
+        ribbon's), written straight into the gradient and the band."""
         x = q[self.node_dofs]
-        t, d1, m1, m2, m_ref = self.frames(q)
-        edges = x[1:] - x[:-1]
-        e_s, g_s, h_s = stretching_energy(edges, self.rest_edge_lengths, self.stretch_stiffness,
-                                          gradient=gradient, hessian=hessian)
-        geom = StencilGeometry(x[:-2], x[1:-1], x[2:], m1[:-1], m2[:-1], m1[1:], m2[1:])
         theta = q[self.theta_dofs]
-        tau = theta[1:] - theta[:-1] + m_ref
-        parts, g_stencil, h_stencil = self.curvature_energy(geom, tau, gradient, hessian)
-        parts = {"stretching": float(e_s.sum()), **parts}
+        t, d1, m1, m2, m_ref = rod_frames(x, self._tangents, self._d1, theta, self._ref_twist)
+        kappa_n, kappa_g = material_curvatures(x, m1, m2)
+        tau = discrete_twist(theta, m_ref)
+        parts, first, second = self.stencil_density(kappa_n, kappa_g, tau)
+        hessian = hessian and gradient
+        n = self.n_dof
+        grad = np.zeros(n) if gradient else np.empty(0)
+        band = np.zeros((self.bandwidth + 1) * n) if hessian else np.empty(0)
+        stretching = add_edge_terms(x, self._edge_nodes, self.rest_edge_lengths, self.stretch_stiffness, 4, n,
+                                    grad, band, gradient, hessian)
+        parts = {"stretching": float(stretching), **parts}
         out = Evaluation(energy=sum(parts.values()), parts=parts, frames=(t, d1, m_ref))
-        if not gradient:
-            return out
-        grad = np.zeros(self.n_dof)
-        g_edge, h_edge = two_node_blocks(g_s, h_s if hessian else np.zeros((len(edges), 3, 3)))
-        grad += np.bincount(self._edge_index.ravel(), weights=g_edge.ravel(), minlength=self.n_dof)
-        grad += np.bincount(self._stencil_index.ravel(), weights=g_stencil.ravel(), minlength=self.n_dof)
-        out.gradient = grad
+        if gradient:
+            add_stencil_terms(x, m1, m2, first, second, 0, n, grad, band, hessian)
+            out.gradient = grad
         if hessian:
-            h7 = np.zeros((len(edges), 7, 7))
-            idx = np.r_[0, 1, 2, 4, 5, 6]
-            h7[:, idx[:, None], idx[None, :]] = h_edge
-            out.hessian = self._assembler.assemble([h7, h_stencil])
+            out.hessian = SymmetricBanded(band.reshape(self.bandwidth + 1, n))
         return out
 
-    def curvature_energy(self, geom: StencilGeometry, tau: np.ndarray, gradient: bool, hessian: bool):
-        """Bending (Eq. 4) and twisting energies of the interior nodes: totals per part, and the
-        per-stencil gradients (S, 11) and Hessians (S, 11, 11) where asked (the ribbon overrides it)."""
+    def stencil_density(self, kappa_n: np.ndarray, kappa_g: np.ndarray, tau: np.ndarray):
+        """Bending (Eq. 6b) and twisting (Eq. 6c) of the interior nodes as functions of the strains:
+        totals per part, partials (n, 3) and second partials (n, 3, 3) in (kappa_n, kappa_g, tau)
+        (the ribbon overrides it)."""
         s = self.strip
-        if hessian and gradient:
-            e_b, e_t, g_b, g_t, h_bt = self._bend_twist_fused(geom, tau)
-            h_b, h_t = h_bt, 0.0
-        else:
-            e_b, g_b, h_b = bending_energy(geom, self.voronoi_lengths, s.bending_stiffness,
-                                           s.geodesic_bending_stiffness, gradient=gradient, hessian=False)
-            g_tau = twist_derivatives(geom, hessian=False)[0] if gradient else None
-            e_t, g_t, h_t = twisting_energy(tau, self.voronoi_lengths, s.twisting_stiffness, g_tau, None)
-        parts = {"bending": float(e_b.sum()), "twisting": float(e_t.sum())}
-        return parts, (g_b + g_t if gradient else None), (h_b + h_t if hessian else None)
-
-    def _bend_twist_fused(self, geom: StencilGeometry, tau: np.ndarray):
-        """Bending (Eq. 6b) and twisting (Eq. 6c) with one mapping of their Hessians to 11x11.
-
-        Same result as rod_bending.bending_energy + rod_twist.twisting_energy (tested), but
-        the curvature and twist second-derivative terms are summed in edge form first.
-        """
-        s = self.strip
-        (kn, gn, hn), (kg, gg, hg) = curvature_derivatives(geom)
-        g_tau, h_tau = twist_derivatives(geom)
-        a = s.bending_stiffness / self.voronoi_lengths
-        c = s.geodesic_bending_stiffness / self.voronoi_lengths
-        k = s.twisting_stiffness / self.voronoi_lengths
-        e_b = 0.5 * (a * kn**2 + c * kg**2)
-        e_t = 0.5 * k * tau**2
-        g_b = (a * kn)[:, None] * gn + (c * kg)[:, None] * gg
-        g_t = (k * tau)[:, None] * g_tau
-        hess = hn.scaled_sum([a * kn, c * kg, k * tau], [hg, h_tau]).to_stencil()
-        hess += (a[:, None, None] * (gn[:, :, None] * gn[:, None, :]) + c[:, None, None] * (gg[:, :, None] * gg[:, None, :])
-                 + k[:, None, None] * (g_tau[:, :, None] * g_tau[:, None, :]))
-        return e_b, e_t, g_b, g_t, hess
+        e_b, f_b, s_b = bending_density(kappa_n, kappa_g, self.voronoi_lengths, s.bending_stiffness,
+                                        s.geodesic_bending_stiffness)
+        e_t, f_t, s_t = twisting_density(tau, self.voronoi_lengths, s.twisting_stiffness)
+        return {"bending": float(e_b.sum()), "twisting": float(e_t.sum())}, f_b + f_t, s_b + s_t
 
     # ------------------------------------------------------------------ linear algebra
     def eigenvalue_metric(self) -> tuple[np.ndarray, float]:

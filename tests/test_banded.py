@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from ddg.solve.banded import BandAssembler, SymmetricBanded
+from ddg.solve.band_scatter import add_pair_block, add_symmetric_block
+from ddg.solve.banded import SymmetricBanded
 
 
 def random_banded(n, bandwidth, lowest, seed=0):
@@ -38,15 +39,23 @@ def test_solve_matvec_restrict(lowest):
     assert np.allclose(K.scaled(s).to_dense(), s[:, None] * dense * s[None, :])
 
 
-def test_assembler_sums_overlapping_blocks():
-    n, m = 15, 7
-    offsets = np.array([0, 4, 8])
+def test_scatter_sums_overlapping_blocks_into_the_band():
+    """Symmetric element blocks on arbitrary (distinct) DOFs, and pair blocks C entering as C + C^T
+    (with shared DOFs, landing twice on their diagonal), summed into lower band storage equal the
+    dense sums."""
+    n, bandwidth = 15, 10
     rng = np.random.default_rng(5)
-    blocks = rng.standard_normal((3, m, m))
-    blocks = blocks + blocks.transpose(0, 2, 1)
-    asm = BandAssembler(n, 10)
-    asm.add_family(offsets, m)
+    band = np.zeros((bandwidth + 1) * n)
     dense = np.zeros((n, n))
-    for o, b in zip(offsets, blocks):
-        dense[o:o + m, o:o + m] += b
-    assert np.allclose(asm.assemble([blocks]).to_dense(), dense)
+    for dofs in (np.array([0, 1, 2, 4, 5, 6, 7]), np.array([9, 3, 5, 8, 4, 6, 7]), np.array([14, 8, 10, 12, 13, 11, 9])):
+        block = rng.standard_normal((7, 7))
+        block = block + block.T
+        add_symmetric_block(band, n, dofs, block)
+        dense[np.ix_(dofs, dofs)] += block
+    rows, cols = np.array([3, 4, 5, 6]), np.array([5, 6, 7, 9])
+    cross = rng.standard_normal((4, 4))
+    add_pair_block(band, n, rows, cols, cross)
+    pair = np.zeros((n, n))
+    np.add.at(pair, (rows[:, None], cols[None, :]), cross)
+    dense += pair + pair.T
+    assert np.allclose(SymmetricBanded(band.reshape(bandwidth + 1, n)).to_dense(), dense, rtol=1e-14, atol=1e-14)

@@ -27,24 +27,19 @@ g = P m / |u| its gradient, and B(g) the 9 x 9 block matrix from the bilinearity
 vertices: blocks (i, i+1) = -[g]x and (i+1, i) = +[g]x (indices mod 3).
 The triangle terms cost O(T) and the hinge terms O(H); no per-hinge 12 x 12 second
 derivatives of normals are formed.
+
+Compiled (numba): `triangle_normal`, `triangle_terms` and `hinge_cross_block` are the one
+implementation, per element; `hinge_bending_energy` returns the blocks per element (tests,
+analysis) and `add_hinge_terms` writes the same terms straight into the assembled gradient and band.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
-def _bilinear_positions():
-    """Flat positions in a 9 x 9 block of the entries (a, b) of blocks (i, i+1) and (i+1, i)."""
-    upper, lower = [], []
-    for i in range(3):
-        j = (i + 1) % 3
-        for a in range(3):
-            for b in range(3):
-                upper.append((3 * i + a) * 9 + 3 * j + b)
-                lower.append((3 * j + a) * 9 + 3 * i + b)
-    return np.array(upper), np.array(lower)
-
-
-_BILINEAR_UPPER, _BILINEAR_LOWER = _bilinear_positions()
+from ..solve.band_scatter import add_pair_block, add_symmetric_block
 
 
 def cross_matrix(v: np.ndarray) -> np.ndarray:
@@ -54,14 +49,6 @@ def cross_matrix(v: np.ndarray) -> np.ndarray:
     m[..., 1, 0], m[..., 1, 2] = v[..., 2], -v[..., 0]
     m[..., 2, 0], m[..., 2, 1] = -v[..., 1], v[..., 0]
     return m
-
-
-def triangle_normals(x: np.ndarray, triangles: np.ndarray):
-    """Unit normals (T, 3) and doubled areas |u| (T,) of the deformed triangles."""
-    p = x[triangles]
-    u = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    double_area = np.linalg.norm(u, axis=1)
-    return u / double_area[:, None], double_area
 
 
 def hinge_stiffness(rest_edge_lengths: np.ndarray, rest_pair_areas: np.ndarray, bending_stiffness: float) -> np.ndarray:
@@ -74,6 +61,166 @@ def hinge_stiffness(rest_edge_lengths: np.ndarray, rest_pair_areas: np.ndarray, 
     return 0.5 * bending_stiffness * rest_edge_lengths**2 / rest_pair_areas
 
 
+# ---------------------------------------------------------------------------- per element
+@njit(cache=True, inline="always")
+def triangle_normal(x, tri, out):
+    """Unit normal of triangle tri (3 node indices into x (N, 3)) into out; returns |u| (twice the area)."""
+    p0, p1, p2 = tri[0], tri[1], tri[2]
+    a0, a1, a2 = x[p1, 0] - x[p0, 0], x[p1, 1] - x[p0, 1], x[p1, 2] - x[p0, 2]
+    b0, b1, b2 = x[p2, 0] - x[p0, 0], x[p2, 1] - x[p0, 1], x[p2, 2] - x[p0, 2]
+    u0, u1, u2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    norm = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    out[0], out[1], out[2] = u0 / norm, u1 / norm, u2 / norm
+    return norm
+
+
+@njit(cache=True)
+def triangle_terms(x, tri, n, double_area, m, grad, hess, jt, want_hessian):
+    """A triangle's share of the hinge energy's derivatives, given its unit normal n, |u| and
+    m = sum over its hinges of c_h n_other: grad (9,) = -2 J^T m; hess (9, 9) = -2 (S Hu S^T + B(g));
+    jt (9, 3) = J^T = S P / |u|, kept for the hinge cross blocks."""
+    opp = np.empty((3, 3))  # e_i = p_{i+1} - p_{i+2}, the edge opposite vertex i
+    for i in range(3):
+        a, b = tri[(i + 1) % 3], tri[(i + 2) % 3]
+        for k in range(3):
+            opp[i, k] = x[a, k] - x[b, k]
+    proj = np.empty((3, 3))
+    for a in range(3):
+        for b in range(3):
+            proj[a, b] = (1.0 if a == b else 0.0) - n[a] * n[b]
+    pm = np.empty(3)
+    for a in range(3):
+        pm[a] = proj[a, 0] * m[0] + proj[a, 1] * m[1] + proj[a, 2] * m[2]
+    inv = 1.0 / double_area
+    g0, g1, g2 = pm[0] * inv, pm[1] * inv, pm[2] * inv
+    # S = [[e_0]x; [e_1]x; [e_2]x] (9 x 3): rows of [e]x are (0, -e2, e1), (e2, 0, -e0), (-e1, e0, 0)
+    S = np.zeros((9, 3))
+    for i in range(3):
+        e0, e1, e2 = opp[i, 0], opp[i, 1], opp[i, 2]
+        S[3 * i, 1], S[3 * i, 2] = -e2, e1
+        S[3 * i + 1, 0], S[3 * i + 1, 2] = e2, -e0
+        S[3 * i + 2, 0], S[3 * i + 2, 1] = -e1, e0
+    for r in range(9):
+        grad[r] = -2.0 * (S[r, 0] * g0 + S[r, 1] * g1 + S[r, 2] * g2)
+        for b in range(3):
+            jt[r, b] = (S[r, 0] * proj[0, b] + S[r, 1] * proj[1, b] + S[r, 2] * proj[2, b]) * inv
+    if not want_hessian:
+        return
+    mn = m[0] * n[0] + m[1] * n[1] + m[2] * n[2]
+    hu = np.empty((3, 3))
+    for a in range(3):
+        for b in range(3):
+            hu[a, b] = -(pm[a] * n[b] + n[a] * pm[b] + mn * proj[a, b]) * inv * inv
+    shu = np.empty((9, 3))
+    for r in range(9):
+        for b in range(3):
+            shu[r, b] = S[r, 0] * hu[0, b] + S[r, 1] * hu[1, b] + S[r, 2] * hu[2, b]
+    for r in range(9):
+        for c in range(9):
+            hess[r, c] = shu[r, 0] * S[c, 0] + shu[r, 1] * S[c, 1] + shu[r, 2] * S[c, 2]
+    # B(g): blocks (i, i+1) = -[g]x, (i+1, i) = +[g]x
+    for i in range(3):
+        j = (i + 1) % 3
+        hess[3 * i, 3 * j + 1] += g2
+        hess[3 * i, 3 * j + 2] -= g1
+        hess[3 * i + 1, 3 * j] -= g2
+        hess[3 * i + 1, 3 * j + 2] += g0
+        hess[3 * i + 2, 3 * j] += g1
+        hess[3 * i + 2, 3 * j + 1] -= g0
+        hess[3 * j, 3 * i + 1] -= g2
+        hess[3 * j, 3 * i + 2] += g1
+        hess[3 * j + 1, 3 * i] += g2
+        hess[3 * j + 1, 3 * i + 2] -= g0
+        hess[3 * j + 2, 3 * i] -= g1
+        hess[3 * j + 2, 3 * i + 1] += g0
+    for r in range(9):
+        for c in range(9):
+            hess[r, c] *= -2.0
+
+
+@njit(cache=True, inline="always")
+def hinge_cross_block(jt_a, jt_b, stiffness, out):
+    """C = -2 c_h J_a^T J_b (9 x 9; rows: triangle a's coordinates, columns: b's); enters as C + C^T."""
+    for r in range(9):
+        for c in range(9):
+            out[r, c] = -2.0 * stiffness * (jt_a[r, 0] * jt_b[c, 0] + jt_a[r, 1] * jt_b[c, 1] + jt_a[r, 2] * jt_b[c, 2])
+
+
+@njit(cache=True)
+def _normals_and_energy(x, triangles, hinge_triangles, stiffness):
+    count = triangles.shape[0]
+    normals = np.empty((count, 3))
+    double_area = np.empty(count)
+    for t in range(count):
+        double_area[t] = triangle_normal(x, triangles[t], normals[t])
+    energy = np.empty(hinge_triangles.shape[0])
+    m = np.zeros((count, 3))
+    for h in range(hinge_triangles.shape[0]):
+        a, b = hinge_triangles[h, 0], hinge_triangles[h, 1]
+        d0, d1, d2 = normals[a, 0] - normals[b, 0], normals[a, 1] - normals[b, 1], normals[a, 2] - normals[b, 2]
+        energy[h] = stiffness[h] * (d0 * d0 + d1 * d1 + d2 * d2)
+        for k in range(3):
+            m[a, k] += stiffness[h] * normals[b, k]
+            m[b, k] += stiffness[h] * normals[a, k]
+    return normals, double_area, energy, m
+
+
+@njit(cache=True)
+def _blocks(x, triangles, hinge_triangles, stiffness, want_hessian):
+    normals, double_area, energy, m = _normals_and_energy(x, triangles, hinge_triangles, stiffness)
+    count = triangles.shape[0]
+    grad = np.empty((count, 9))
+    hess = np.zeros((count, 9, 9))
+    jt = np.empty((count, 9, 3))
+    for t in range(count):
+        triangle_terms(x, triangles[t], normals[t], double_area[t], m[t], grad[t], hess[t], jt[t], want_hessian)
+    cross = np.zeros((hinge_triangles.shape[0] if want_hessian else 0, 9, 9))
+    if want_hessian:
+        for h in range(hinge_triangles.shape[0]):
+            hinge_cross_block(jt[hinge_triangles[h, 0]], jt[hinge_triangles[h, 1]], stiffness[h], cross[h])
+    return energy, grad, hess, cross
+
+
+@njit(cache=True)
+def add_hinge_terms(x, triangles, hinge_triangles, stiffness, n_dof, grad, band, want_gradient, want_hessian):
+    """Eq. (11b) assembled: adds the gradient (3 DOFs per node, node j at 3 j) to grad and the
+    Hessian to the flattened lower band where asked; returns the energy."""
+    normals, double_area, energy, m = _normals_and_energy(x, triangles, hinge_triangles, stiffness)
+    total = energy.sum()
+    if not want_gradient:
+        return total
+    count = triangles.shape[0]
+    g9 = np.empty(9)
+    h9 = np.zeros((9, 9))
+    cross = np.empty((9, 9))
+    jt = np.empty((count, 9, 3))
+    dofs = np.empty((count, 9), dtype=np.int64)
+    for t in range(count):
+        for i in range(3):
+            for k in range(3):
+                dofs[t, 3 * i + k] = 3 * triangles[t, i] + k
+        triangle_terms(x, triangles[t], normals[t], double_area[t], m[t], g9, h9, jt[t], want_hessian)
+        for r in range(9):
+            grad[dofs[t, r]] += g9[r]
+        if want_hessian:
+            add_symmetric_block(band, n_dof, dofs[t], h9)
+    if want_hessian:
+        for h in range(hinge_triangles.shape[0]):
+            a, b = hinge_triangles[h, 0], hinge_triangles[h, 1]
+            hinge_cross_block(jt[a], jt[b], stiffness[h], cross)
+            add_pair_block(band, n_dof, dofs[a], dofs[b], cross)
+    return total
+
+
+# ---------------------------------------------------------------------------- array interface
+def triangle_normals(x: np.ndarray, triangles: np.ndarray):
+    """Unit normals (T, 3) and doubled areas |u| (T,) of the deformed triangles."""
+    p = x[triangles]
+    u = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    double_area = np.linalg.norm(u, axis=1)
+    return u / double_area[:, None], double_area
+
+
 def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: np.ndarray, stiffness: np.ndarray,
                          *, gradient: bool = True, hessian: bool = True):
     """Eq. (11b) for the deformed node positions x (N, 3).
@@ -82,40 +229,14 @@ def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: 
     (T, 9, 9), cross blocks per hinge (H, 9, 9)), all in the triangles' own vertex order: the
     cross block C couples triangle a's nine coordinates (rows) with triangle b's (columns) and
     enters the Hessian as C + C^T (the shared edge's nodes appear in both, where C + C^T
-    lands on the same entries twice). Unrequested parts are None. Assembly sums the blocks
-    (ddg.models.plate).
+    lands on the same entries twice). Unrequested parts are None. The models assemble the same
+    terms with `add_hinge_terms`.
     """
-    n, double_area = triangle_normals(x, triangles)
-    tri_a, tri_b = hinge_triangles[:, 0], hinge_triangles[:, 1]
-    diff = n[tri_a] - n[tri_b]
-    energy = stiffness * np.einsum("hi,hi->h", diff, diff)
+    x = np.ascontiguousarray(x, dtype=float)
+    triangles = np.ascontiguousarray(triangles, dtype=np.int64)
+    hinge_triangles = np.ascontiguousarray(hinge_triangles, dtype=np.int64)
+    stiffness = np.ascontiguousarray(np.broadcast_to(stiffness, (len(hinge_triangles),)), dtype=float)
     if not gradient:
-        return energy, None, None, None
-    count = len(triangles)
-    m = np.stack([np.bincount(tri_a, weights=stiffness * n[tri_b, k], minlength=count)
-                  + np.bincount(tri_b, weights=stiffness * n[tri_a, k], minlength=count) for k in range(3)], axis=1)
-    p = x[triangles]
-    opposite = np.stack([p[:, 1] - p[:, 2], p[:, 2] - p[:, 0], p[:, 0] - p[:, 1]], axis=1)  # e_i, (T, 3, 3)
-    S = cross_matrix(opposite).reshape(count, 9, 3)
-    projector = np.eye(3) - n[:, :, None] * n[:, None, :]
-    pm = np.einsum("tij,tj->ti", projector, m)
-    g_u = pm / double_area[:, None]
-    grad = -2.0 * (S @ g_u[:, :, None])[:, :, 0]
-    if not hessian:
-        return energy, grad, None, None
-    mn = np.einsum("ti,ti->t", m, n)
-    h_u = -(pm[:, :, None] * n[:, None, :] + n[:, :, None] * pm[:, None, :] + mn[:, None, None] * projector)
-    h_u /= (double_area**2)[:, None, None]
-    St = S.transpose(0, 2, 1)
-    hess_tri = S @ h_u @ St
-    # B(g): blocks (i, i+1) = -[g]x, (i+1, i) = +[g]x; [g]x is antisymmetric, so both are
-    # +/- the same nine numbers at fixed positions of the flattened 9 x 9 block
-    G = cross_matrix(g_u).reshape(count, 9)
-    flat = hess_tri.reshape(count, 81)
-    flat[:, _BILINEAR_UPPER] -= np.tile(G, 3)
-    flat[:, _BILINEAR_LOWER] += np.tile(G, 3)
-    hess_tri *= -2.0
-
-    Jt = S @ (projector / double_area[:, None, None])  # J^T, (T, 9, 3): P is symmetric
-    cross = Jt[tri_a] @ (Jt[tri_b].transpose(0, 2, 1) * (-2.0 * stiffness)[:, None, None])
-    return energy, grad, hess_tri, cross
+        return _normals_and_energy(x, triangles, hinge_triangles, stiffness)[2], None, None, None
+    energy, grad, hess, cross = _blocks(x, triangles, hinge_triangles, stiffness, bool(hessian))
+    return energy, grad, (hess if hessian else None), (cross if hessian else None)

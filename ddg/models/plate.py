@@ -27,12 +27,12 @@ import math
 
 import numpy as np
 
-from ..energies.hinge_bending import hinge_bending_energy, hinge_stiffness, triangle_normals
-from ..energies.stretch import stretching_energy, two_node_blocks
+from ..energies.hinge_bending import add_hinge_terms, hinge_stiffness, triangle_normals
+from ..energies.stretch import add_edge_terms
 from ..geometry.centerline import first_mode_profile
 from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, structured_mesh
 from ..geometry.strip import InputError, Strip
-from ..solve.banded import BandAssembler
+from ..solve.banded import SymmetricBanded
 from .base import BandedModel, Evaluation
 
 
@@ -71,13 +71,10 @@ class PlateModel(BandedModel):
                                                mesh.edge_triangle_areas[hinge_edges], E * b**3 / 12.0)
 
         self.bandwidth = 3 * mesh.bandwidth_nodes() + 2
-        self._assembler = BandAssembler(self.n_dof, self.bandwidth)
-        self._edge_dofs = self.node_dofs[mesh.edges].reshape(-1, 6)
-        self._triangle_dofs = self.node_dofs[mesh.triangles].reshape(-1, 9)
-        self._assembler.add_indexed_family(self._edge_dofs)
-        self._assembler.add_indexed_family(self._triangle_dofs)
-        self._assembler.add_pair_family(self._triangle_dofs[mesh.hinge_triangles[:, 0]],
-                                        self._triangle_dofs[mesh.hinge_triangles[:, 1]])
+        # connectivity as the compiled kernels take it (int64, contiguous), built once per mesh
+        self._edges = np.ascontiguousarray(mesh.edges, dtype=np.int64)
+        self._triangles = np.ascontiguousarray(mesh.triangles, dtype=np.int64)
+        self._hinge_triangles = np.ascontiguousarray(mesh.hinge_triangles, dtype=np.int64).reshape(-1, 2)
         self._centre = mesh.interpolation_matrix(np.array([[0.5 * strip.length, 0.0]]))
         quarter = np.array([[0.25 * strip.length, 0.0], [0.75 * strip.length, 0.0]])
         self._quarters = mesh.interpolation_matrix(quarter)
@@ -170,26 +167,23 @@ class PlateModel(BandedModel):
 
     # ------------------------------------------------------------------ energy
     def evaluate(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
-        mesh = self.mesh
-        x = q[self.node_dofs]
-        edges = x[mesh.edges[:, 1]] - x[mesh.edges[:, 0]]
-        e_s, g_s, h_s = stretching_energy(edges, self.rest_edge_lengths, self.stretch_stiffness,
-                                          gradient=gradient, hessian=hessian)
-        e_b, g_b, h_tri, h_hinge = hinge_bending_energy(x, mesh.triangles, mesh.hinge_triangles,
-                                                        self.hinge_stiffness, gradient=gradient, hessian=hessian)
-        parts = {"stretching": float(e_s.sum()), "bending": float(e_b.sum())}
+        """Energy (Eq. 11), gradient and banded Hessian at q: compiled passes over the edges (Eq. 11a)
+        and the triangles and hinges (Eq. 11b), written straight into the gradient and the band."""
+        x = q.reshape(-1, 3)
+        hessian = hessian and gradient
+        n = self.n_dof
+        grad = np.zeros(n) if gradient else np.empty(0)
+        band = np.zeros((self.bandwidth + 1) * n) if hessian else np.empty(0)
+        stretching = add_edge_terms(x, self._edges, self.rest_edge_lengths, self.stretch_stiffness, 3, n,
+                                    grad, band, gradient, hessian)
+        bending = add_hinge_terms(x, self._triangles, self._hinge_triangles, self.hinge_stiffness, n,
+                                  grad, band, gradient, hessian)
+        parts = {"stretching": float(stretching), "bending": float(bending)}
         out = Evaluation(energy=parts["stretching"] + parts["bending"], parts=parts)
-        if not gradient:
-            return out
+        if gradient:
+            out.gradient = grad
         if hessian:
-            g_edge, h_edge = two_node_blocks(g_s, h_s)
-        else:
-            g_edge = np.concatenate([-g_s, g_s], axis=1)
-        grad = np.bincount(self._edge_dofs.ravel(), weights=g_edge.ravel(), minlength=self.n_dof)
-        grad += np.bincount(self._triangle_dofs.ravel(), weights=g_b.ravel(), minlength=self.n_dof)
-        out.gradient = grad
-        if hessian:
-            out.hessian = self._assembler.assemble([h_edge, h_tri, h_hinge])
+            out.hessian = SymmetricBanded(band.reshape(self.bandwidth + 1, n))
         return out
 
     # ------------------------------------------------------------------ metrics and scales

@@ -1,84 +1,17 @@
-"""Symmetric banded matrices (lower storage): assembly, Cholesky, solves, eigenvalues.
+"""Symmetric banded matrices (lower storage): Cholesky, solves, eigenvalues.
 
 Storage follows LAPACK's lower band form: band[d, j] = A[j + d, j] for 0 <= d <= bandwidth.
 The rod's DOF vector (Eq. 1) interleaves positions and twists so that every element touches
 a contiguous block of at most 11 DOFs: the Hessian has bandwidth 10 and Newton costs O(M).
 The plate orders its nodes along the strip (ddg.geometry.plate_mesh), so its Hessian is
 banded too, with a bandwidth of about six times the nodes per column: for a strip a banded
-Cholesky beats general sparse factorisations (measured in benchmarks/plate_path.py).
+Cholesky beats general sparse factorisations (measured in benchmarks/plate_linear_algebra.py).
+The element kernels write into this storage directly (ddg.solve.band_scatter).
 """
 from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as sla
-
-
-class BandAssembler:
-    """Precomputed scatter indices from dense element blocks to lower band storage.
-
-    Each element type is a family of (m x m) blocks placed at DOF offsets `offsets`; the
-    flat target index of entry (a, b), a >= b, of block k is (a - b) * n + offsets[k] + b.
-    """
-
-    def __init__(self, n: int, bandwidth: int):
-        self.n = n
-        self.bandwidth = bandwidth
-        self._families: list[tuple[np.ndarray, np.ndarray, str]] = []
-        self._all_flat = None  # concatenated targets of all families, built at the first assemble
-
-    def _add(self, flat: np.ndarray, local: np.ndarray, kind: str) -> int:
-        self._families.append((flat, local, kind))
-        self._all_flat = None
-        return len(self._families) - 1
-
-    def add_family(self, offsets: np.ndarray, size: int) -> int:
-        a, b = np.tril_indices(size)
-        if np.any(a - b > self.bandwidth):
-            raise ValueError("element block wider than the band")
-        flat = (a - b)[None, :] * self.n + offsets[:, None] + b[None, :]
-        local = a * size + b
-        return self._add(flat.ravel(), local, "contiguous")
-
-    def add_indexed_family(self, dofs: np.ndarray) -> int:
-        """A family of symmetric (m x m) blocks on arbitrary DOFs dofs (K, m), e.g. a triangle's
-        nine coordinates; only the entries that fall in the lower band are gathered."""
-        rows, cols = dofs[:, :, None], dofs[:, None, :]
-        lower = np.broadcast_to(rows >= cols, (len(dofs),) + (dofs.shape[1],) * 2)
-        if np.any(np.abs(rows - cols) > self.bandwidth):
-            raise ValueError("element block wider than the band")
-        flat = ((rows - cols) * self.n + cols)[lower]
-        return self._add(flat, np.flatnonzero(lower.ravel()), "indexed")
-
-    def add_pair_family(self, row_dofs: np.ndarray, col_dofs: np.ndarray) -> int:
-        """A family of blocks C (K, m, p) entering the matrix as C + C^T on rows row_dofs (K, m)
-        and columns col_dofs (K, p): each entry lands once in the lower band (twice on the
-        diagonal, where C and C^T coincide)."""
-        rows, cols = row_dofs[:, :, None], col_dofs[:, None, :]
-        if np.any(np.abs(rows - cols) > self.bandwidth):
-            raise ValueError("element block wider than the band")
-        low, high = np.minimum(rows, cols), np.maximum(rows, cols)
-        flat = ((high - low) * self.n + low).ravel()
-        return self._add(flat, np.where(rows == cols, 2.0, 1.0).ravel(), "pair")
-
-    def assemble(self, blocks: list[np.ndarray]) -> "SymmetricBanded":
-        """Sum the element blocks (one array per family, in the order added) into the band:
-        the lower-band entries of all families are gathered into one buffer, one bincount."""
-        if self._all_flat is None:
-            self._all_flat = np.concatenate([f for f, _, _ in self._families])
-            self._buffer = np.empty(len(self._all_flat))
-        start = 0
-        for (flat, local, kind), values in zip(self._families, blocks):
-            out = self._buffer[start:start + len(flat)]
-            if kind == "indexed":  # positions in the whole stack of blocks
-                np.take(values.ravel(), local, out=out)
-            elif kind == "pair":  # local holds the multiplicity (2 on the diagonal)
-                np.multiply(values.ravel(), local, out=out)
-            else:
-                m = values.shape[1]
-                out[:] = values.reshape(-1, m * m)[:, local].ravel()
-            start += len(flat)
-        total = np.bincount(self._all_flat, weights=self._buffer, minlength=(self.bandwidth + 1) * self.n)
-        return SymmetricBanded(total.reshape(self.bandwidth + 1, self.n))
 
 
 class SymmetricBanded:

@@ -85,6 +85,8 @@ def build_parser() -> argparse.ArgumentParser:
     cur.add_argument("--stations", type=int, default=None, help="plate: centerline stations (default ~ columns / 2)")
     cur.add_argument("--out", default="out", help="output directory: curvatures.csv, curvatures.png (default ./out)")
 
+    sub.add_parser("warmup", help="compile and cache the numba kernels once (scripts/setup.sh runs it), "
+                                  "so the first run pays no JIT cost")
     err = sub.add_parser("centerline-error",
                          help="plate centerline approximation error (Eqs. 12-13) against L/W (Fig. 10): CSV and PNG")
     err.add_argument("--width-ratios", default="0.5,0.3333333333333333,0.16666666666666666,0.08333333333333333,0.05",
@@ -332,6 +334,10 @@ def main(argv=None) -> int:
             return cmd_curvatures(args)
         if args.command == "centerline-error":
             return cmd_centerline_error(args)
+        if args.command == "warmup":
+            from .warmup import main as warmup
+
+            return warmup()
         return EXIT_BAD_INPUT
     except InputError as exc:
         sys.stderr.write(f"error: {_one_line(exc)}\n")

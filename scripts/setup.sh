@@ -21,4 +21,6 @@ fi
 /usr/bin/python3 -c "import numpy, scipy; print(f'numpy=={numpy.__version__}'); print(f'scipy=={scipy.__version__}')" > .venv/constraints.txt
 .venv/bin/python -m pip install -q --disable-pip-version-check -c .venv/constraints.txt -r requirements-dev.txt
 .venv/bin/python -m pip install -q --disable-pip-version-check -c .venv/constraints.txt --no-build-isolation --no-deps -e .
-.venv/bin/python -c "import numpy, scipy, ddg; print('ddg', ddg.__version__, 'numpy', numpy.__version__, 'scipy', scipy.__version__)"
+.venv/bin/python -c "import numpy, scipy, numba, ddg; print('ddg', ddg.__version__, 'numpy', numpy.__version__, 'scipy', scipy.__version__, 'numba', numba.__version__)"
+# compile the numba kernels once and cache them (ddg/**/__pycache__), so no run pays the JIT cost
+.venv/bin/python -m ddg warmup

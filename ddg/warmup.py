@@ -1,0 +1,75 @@
+"""Compile and cache every numba kernel once, so that a user's first run pays no JIT cost.
+
+    python -m ddg warmup
+
+runs each compiled kernel on a tiny model with every argument type the solvers use (energy only,
+gradient, gradient and Hessian; rod, ribbon, plate; the array interfaces used in analysis). numba
+stores the machine code next to the modules (`cache=True`, in `__pycache__`); later processes
+load it (~0.2 s for all kernels) instead of compiling (~30-60 s). scripts/setup.sh calls it.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+
+def compile_kernels() -> dict:
+    """Run every kernel once; returns the seconds spent per group (compiling where not cached)."""
+    from .energies.hinge_bending import hinge_bending_energy
+    from .energies.rod_curvature import material_curvatures, strain_derivatives
+    from .energies.stretch import stretching_energy
+    from .geometry.frames import parallel_transport, reference_twist
+    from .geometry.strip import Strip
+    from .models.plate import PlateModel
+    from .models.ribbon import RibbonModel
+    from .models.rod import RodModel
+
+    strip = Strip.from_ratios(1 / 6, 0.5)
+    rng = np.random.default_rng(0)
+    timings = {}
+
+    def timed(name, work):
+        start = time.perf_counter()
+        work()
+        timings[name] = round(time.perf_counter() - start, 3)
+
+    def models():
+        for model in (RodModel(strip, 9), RibbonModel(strip, 9), PlateModel(strip, 40)):
+            q = model.reset()
+            q = q + 1e-3 * strip.length * rng.standard_normal(q.shape)
+            model.commit(q)
+            for gradient, hessian in ((False, False), (True, False), (True, True)):
+                model.evaluate(q, gradient=gradient, hessian=hessian)
+
+    def arrays():
+        x = np.cumsum(rng.standard_normal((6, 3)), axis=0)
+        t = x[1:] - x[:-1]
+        t /= np.linalg.norm(t, axis=1)[:, None]
+        d1 = np.cross(t, rng.standard_normal(t.shape))
+        d1 /= np.linalg.norm(d1, axis=1)[:, None]
+        m2 = np.cross(t, d1)
+        parallel_transport(d1, t, t[::-1].copy())
+        reference_twist(d1, t)
+        reference_twist(d1, t, np.zeros(len(t) - 1))
+        material_curvatures(x, d1, m2)
+        strain_derivatives(x, d1, m2)
+        for gradient, hessian in ((False, False), (True, False), (True, True)):
+            stretching_energy(t, np.ones(len(t)), 1.0, gradient=gradient, hessian=hessian)
+        plate = PlateModel(strip, 40)
+        xp = plate.reset().reshape(-1, 3)
+        for gradient, hessian in ((False, False), (True, False), (True, True)):
+            hinge_bending_energy(xp, plate.mesh.triangles, plate.mesh.hinge_triangles, plate.hinge_stiffness,
+                                 gradient=gradient, hessian=hessian)
+
+    timed("models", models)
+    timed("array interfaces", arrays)
+    return timings
+
+
+def main() -> int:
+    start = time.perf_counter()
+    timings = compile_kernels()
+    parts = ", ".join(f"{k} {v:.1f} s" for k, v in timings.items())
+    print(f"ddg kernels compiled and cached in {time.perf_counter() - start:.1f} s ({parts})")
+    return 0

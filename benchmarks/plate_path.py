@@ -16,10 +16,8 @@ Newton iterations, whether the path completed (and the library's message), the d
 the evaluations per Newton iteration (full Hessian, gradient only, energy only) and the split of
 the time per Newton iteration between
 
-  (a) element evaluation + assembly: PlateModel.evaluate, split further into the energy kernels
-      (the ddg.energies.* functions PlateModel calls: stretching_energy, two_node_blocks,
-      hinge_bending_energy), the band assembly (BandAssembler.assemble) and the rest of
-      evaluate (gathering positions, edge vectors, gradient bincounts);
+  (a) element evaluation + assembly: PlateModel.evaluate (compiled kernels that write straight
+      into the gradient and the band; not split further since issue 14);
   (b) factorisation and solves: SymmetricBanded.cholesky / .solve and any direct call of
       scipy.linalg.cholesky_banded / cho_solve_banded / solve_banded (and scipy.sparse.linalg
       splu / spsolve / factorized, in case the library starts using them);
@@ -164,7 +162,7 @@ class _Instrument(PathInstrument):
         importlib.import_module("ddg.api")  # loads every module whose references are rebound below
         from ddg.models import plate
         from ddg.solve import banded, stability
-        from ddg.solve.banded import BandAssembler, SymmetricBanded
+        from ddg.solve.banded import SymmetricBanded
 
         inst = self
 
@@ -193,8 +191,8 @@ class _Instrument(PathInstrument):
             self._patch_function(plate, name, f"{plate.__dict__[name].__module__}.{name}", "kernels")
         if not kernels:
             self.notes.append("no ddg.energies functions found in ddg.models.plate; kernel time not separated")
-        # (a2) assembly
-        self._patch_method(BandAssembler, "assemble", "BandAssembler.assemble", "assembly")
+        # (a2) assembly: since issue 14 the compiled kernels write straight into the band (no separate
+        # assembly step); the kernels are numba dispatchers, timed as a whole inside evaluate
 
         # (b) factorisation and solves
         chol = SymmetricBanded.__dict__["cholesky"]

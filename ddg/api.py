@@ -142,6 +142,7 @@ def fill_thresholds(summary: dict, model, options, brackets: dict) -> None:
     for key, name in (("dW1", "dW1_over_L"), ("dW2", "dW2_over_L"), ("dW2_S_stable", "dW2_S_stable_over_L")):
         summary[name] = None if found[key] is None else abs(found[key]) / L
     summary["threshold_wall_time_s"] = time.perf_counter() - t0
+    summary["threshold_newton_iterations"] = found["newton_iterations"]
 
 
 THRESHOLD_KEYS = ("dW1_over_L", "dW2_over_L", "dW2_S_stable_over_L")
@@ -469,6 +470,8 @@ def simulate(
     except Exception as exc:  # noqa: BLE001
         error = exc
     summary["newton_iterations"] = follower.newton_iterations
+    summary["newton_iterations_by_phase"] = {**follower.iterations_by_phase,
+                                             "line search trials": follower.line_search_trials}
     summary["folds_dW_over_L"] = _distinct([abs(f) / L for f in follower.folds], 1e-4)
     summary["wall_time_s"] = time.perf_counter() - t0
     finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,

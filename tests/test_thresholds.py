@@ -61,11 +61,13 @@ def test_thresholds_do_not_depend_on_the_size_of_the_kick(narrow_rod):
     small, reference = small_run.summary, narrow_rod[100].summary
     assert abs(small["dW1_over_L"] - reference["dW1_over_L"]) < 1e-4
     assert abs(small["dW2_over_L"] - reference["dW2_over_L"]) < 1e-3
-    # and the same branch: a push too small to leave the saddle within Newton's tolerance is
-    # grown (10x at a time), not replaced by an energy descent that picks either side
+    # and the same branch: the amplitude along the critical mode grows from the kick (doubling, at
+    # fixed amplitude), never an energy descent that picks either side
     assert list(small_run.column("phase")) == list(narrow_rod[100].column("phase"))
     h_small, h_reference = small_run.column("H_mid_over_L"), narrow_rod[100].column("H_mid_over_L")
-    assert np.max(np.abs(h_small - h_reference)) < 1e-7
+    # measured 1.0e-7 L: the two runs reach US by different amplitude sequences and land on it
+    # within Newton's residual tolerance, where US (just past the pitchfork) is soft
+    assert np.max(np.abs(h_small - h_reference)) < 5e-7
 
 
 def test_phase_labels_follow_U_then_US_then_S(narrow_rod):

@@ -23,6 +23,12 @@ from .stability import lowest_modes
 #: The largest push off an unstable state (relative to L) tried before giving up on it.
 MAX_KICK = 0.05
 
+#: Where a path's Newton iterations go (PathFollower.iterations_by_phase, summary.json
+#: "newton_iterations_by_phase"): solves of load steps that converged and that failed (the step
+#: was then halved), leaving unstable states (branch switching at pitchforks), the compression's
+#: first buckled state, and snaps past folds (pseudo-arclength and energy descent).
+PHASES = ("accepted steps", "rejected steps", "branch switching", "compression start", "fold snaps")
+
 
 def _phase_of(model, state) -> str:
     from ..observables import phase_label
@@ -91,6 +97,13 @@ class PathFollower:
         self._history: list[tuple[np.ndarray, np.ndarray]] = []  # (load, q) of the last equilibria on this branch
         self._fold_tried_at = None
         self.folds: list[float] = []  # dW (m) of the limit points met (pseudo-arclength turned back there)
+        #: Newton iterations per phase of the path (PHASES), the public record of where they go
+        self.iterations_by_phase: dict[str, int] = dict.fromkeys(PHASES, 0)
+        self.line_search_trials = 0  # shortened Newton steps tried in load steps (evaluations, not iterations)
+
+    def _spent(self, iterations: int, phase: str) -> None:
+        self.newton_iterations += iterations
+        self.iterations_by_phase[phase] += iterations
 
     # ------------------------------------------------------------------ predictors
     def _remember(self, state: State, restart: bool = False) -> None:
@@ -144,7 +157,7 @@ class PathFollower:
             q = model.apply_clamps(model.buckled_guess(compression, direction), compression, 0.0)
             model.commit(q)
             result = newton(model, q, self.options.newton, minimize=True)
-            self.newton_iterations += result.iterations
+            self._spent(result.iterations, "compression start")
             if result.converged:
                 state = State(result.q, result.evaluation, compression, 0.0, bool(result.positive_definite),
                               result.iterations)
@@ -238,7 +251,8 @@ class PathFollower:
             q = extrapolated
             q[model.constrained] = new_clamps
             result = newton(model, q, opts)
-            self.newton_iterations += result.iterations
+            self._spent(result.iterations, "accepted steps" if result.converged else "rejected steps")
+            self.line_search_trials += result.line_search_trials
             if not result.converged:
                 model.restore_frames(saved)
                 result = None
@@ -249,7 +263,8 @@ class PathFollower:
             q[model.constrained] = new_clamps
             q[model.free] -= K.solve(model.coupling(state.evaluation.hessian, dq_c))
             result = newton(model, q, opts)
-            self.newton_iterations += result.iterations
+            self._spent(result.iterations, "accepted steps" if result.converged else "rejected steps")
+            self.line_search_trials += result.line_search_trials
         if result is None or not result.converged:
             model.restore_frames(saved)
             return None
@@ -274,7 +289,7 @@ class PathFollower:
                                  ArclengthOptions(initial_step=span / 4, max_step=max(span, 1e-4), max_points=40))
         points, _ = tracer.trace(state, direction,
                                  stop=lambda s: (s.shear - shear) * direction >= 0 or (s.shear - state.shear) * direction < 0)
-        self.newton_iterations += tracer.newton_iterations
+        self._spent(tracer.newton_iterations, "fold snaps")
         shears = np.array([state.shear] + [p.shear for p in points])
         if points and (points[-1].shear - shear) * direction >= 0:
             before, after = ([state] + points)[-2:]
@@ -283,7 +298,7 @@ class PathFollower:
             q = (1 - weight) * before.q + weight * after.q
             q[model.constrained] = model.clamp_values(compression, shear)
             result = newton(model, q, self.options.newton)
-            self.newton_iterations += result.iterations
+            self._spent(result.iterations, "fold snaps")
             if result.converged:
                 new = State(result.q, result.evaluation, compression, shear, bool(result.positive_definite),
                             result.iterations + tracer.newton_iterations)
@@ -323,7 +338,7 @@ class PathFollower:
             return True if (a is True or b is True) else ("drop" if (a or b) else False)
 
         points, why = tracer.trace(turned, direction, stop=stop, max_points=60)
-        self.newton_iterations += tracer.newton_iterations
+        self._spent(tracer.newton_iterations, "fold snaps")
         if why != "stop condition" or not points:
             return None
         junction = points[-1]
@@ -342,7 +357,7 @@ class PathFollower:
             model.restore_frames(junction.frames)
             q[model.constrained] = model.clamp_values(compression, between)
             result = newton(model, q, self.options.newton)
-            self.newton_iterations += result.iterations
+            self._spent(result.iterations, "fold snaps")
             if not result.converged or _phase_of(model, State(result.q, None, compression, between, False)).startswith("US"):
                 return None
             model.commit(result.q, result.evaluation)
@@ -354,7 +369,7 @@ class PathFollower:
         except ContinuationFailure:
             return None
         finally:
-            self.newton_iterations += follower.newton_iterations
+            self._spent(follower.newton_iterations, "fold snaps")
         if not new.stable:
             return None
         new.branch_switched = True
@@ -367,7 +382,7 @@ class PathFollower:
         q = model.apply_clamps(state.q, compression, shear)
         model.commit(q)
         result = newton(model, q, self.options.newton, minimize=True)
-        self.newton_iterations += result.iterations
+        self._spent(result.iterations, "fold snaps")
         if result.converged and result.positive_definite:
             return State(result.q, result.evaluation, compression, shear, True, result.iterations, branch_switched=True)
         model.restore_frames(saved)
@@ -390,8 +405,12 @@ class PathFollower:
         sign = 1.0 if model.mode_sign(mode, direction) >= 0 else -1.0
         if direction == 0:
             sign *= self.options.branch_sign
-        # close to a pitchfork lambda_min is small, and a push of 1e-5 L may leave a residual below
-        # Newton's tolerance at the saddle itself: grow the push until the descent gets away
+        slid = self._slide_along_mode(state, sign * mode)
+        if slid is not None:
+            return slid
+        # fallback: close to a pitchfork lambda_min is small, and a push of 1e-5 L may leave a
+        # residual below Newton's tolerance at the saddle itself: grow the push until the descent
+        # gets away
         k = self.options.kick
         pushes = [k] + [k * 10**j for j in range(1, 4) if k * 10**j <= MAX_KICK] + [0.1 * k]
         for kick in pushes:
@@ -399,9 +418,127 @@ class PathFollower:
             q = state.q + sign * kick * self._length * mode
             model.commit(q)
             result = newton(model, q, self.options.newton, minimize=True)
-            self.newton_iterations += result.iterations
+            self._spent(result.iterations, "branch switching")
             if result.converged and result.positive_definite:
                 return State(result.q, result.evaluation, state.compression, state.shear, True,
                              state.iterations + result.iterations, branch_switched=True)
             model.restore_frames(saved)
+        return None
+
+    def _constrained_equilibrium(self, q: np.ndarray, origin: np.ndarray, direction: np.ndarray, amplitude: float):
+        """Equilibrium with the amplitude along `direction` (free DOFs) held: grad_f E + mu w = 0,
+        w . (q_f - origin_f) / (w . w) = amplitude. Bordered Newton (two solves with one
+        factorisation per iteration); returns (q, evaluation, mu) or None. The rod's frames are
+        committed at every iterate, as in newton()."""
+        model = self.model
+        free = model.free
+        w = direction[free]
+        ww = float(w @ w)
+        rscale = model.residual_scale()[free]
+        tol = max(self.options.newton.residual_tol, model.residual_floor())
+        q = q.copy()
+        mu, first = 0.0, None
+        ev = model.evaluate(q)
+        for iteration in range(self.options.newton.max_iterations + 1):
+            r = ev.gradient[free] + mu * w
+            c = float(w @ (q[free] - origin[free])) / ww - amplitude
+            res = float(np.max(np.abs(r / rscale)))
+            if not np.isfinite(res):
+                return None
+            if res < tol and abs(c) < 1e-12 * self._length:
+                return q, ev, mu
+            first = res if first is None else first
+            if iteration == self.options.newton.max_iterations or res > 1e3 * first:
+                return None
+            K = model.free_matrix(ev.hessian)
+            x1, x2 = K.solve(np.column_stack([-r, w])).T
+            dmu = (float(w @ x1) + c * ww) / float(w @ x2)
+            q[free] += x1 - dmu * x2
+            mu += dmu
+            ev = model.evaluate(q)
+            self._spent(1, "branch switching")
+            model.commit(q, ev)
+        return None
+
+    def _slide_along_mode(self, unstable: State, mode: np.ndarray) -> State | None:
+        """From an unstable equilibrium to the stable one its lowest mode leads to (the US branch
+        past a pitchfork, the buckled branch from the flat state), without energy descent.
+
+        The amplitude a along the mode is held (_constrained_equilibrium) and doubled from the
+        kick while the energy keeps falling with it (the multiplier mu has the sign of -dE/da),
+        then the root of mu(a) is bracketed and found by the secant method; plain Newton from there
+        lands on the equilibrium, accepted if stable. A fixed push followed by modified Newton
+        slides along the soft, curved valley instead: 225 iterations past the rod's pitchfork
+        (M = 100) against ~30 here."""
+        model = self.model
+        L = self._length
+        saved = model.save_frames()
+        origin = unstable.q
+        points = []  # (a, q, mu * direction, frames)
+
+        def solve(q, a):
+            out = self._constrained_equilibrium(q, origin, mode, a * L)
+            if out is None:
+                return None
+            points.append((a, out[0], out[2], model.save_frames(), out[1]))
+            return points[-1]
+
+        a = self.options.kick
+        model.commit(origin + a * L * mode)
+        if solve(origin + a * L * mode, a) is None or points[-1][2] <= 0.0:
+            model.restore_frames(saved)
+            return None  # the energy does not fall along the mode: not a saddle we can leave this way
+        growth = 2.0
+        while points[-1][2] > 0.0:  # energy still falling: double the amplitude
+            a0, q0, _, frames0, _ = points[-1]
+            a = growth * a0
+            if a > 0.5:
+                model.restore_frames(saved)
+                return None
+            if len(points) >= 2:  # linear extrapolation in a of the constrained branch
+                a1, q1 = points[-2][0], points[-2][1]
+                predicted = q0 + (q0 - q1) * (a - a0) / (a0 - a1)
+            else:
+                predicted = q0 + (a - a0) * L * mode
+            model.restore_frames(frames0)
+            if solve(predicted, a) is None:
+                model.restore_frames(frames0)
+                growth = 1.0 + 0.5 * (growth - 1.0)  # a shorter step along the constrained branch
+                if growth < 1.1:
+                    model.restore_frames(saved)
+                    return None
+        # the root of mu(a) lies between the last two amplitudes: secant steps on the constrained
+        # branch, each predicted by extrapolation from the two solved points nearest below it (a
+        # chord between the bracket's ends is too far off the curved branch); Newton from a point
+        # whose multiplier is small lands on the equilibrium
+        lo, hi = points[-2], points[-1]
+        below = points[-3] if len(points) >= 3 else None
+        side = 0
+        for _ in range(12):
+            if abs(lo[2]) <= 0.05 * abs(hi[2]) or abs(hi[2]) <= 0.05 * abs(lo[2]):
+                nearest = lo if abs(lo[2]) <= abs(hi[2]) else hi
+                model.restore_frames(nearest[3])
+                result = newton(model, nearest[1], self.options.newton, evaluation=nearest[4])
+                self._spent(result.iterations, "branch switching")
+                if result.converged and result.positive_definite:
+                    return State(result.q, result.evaluation, unstable.compression, unstable.shear, True,
+                                 unstable.iterations + result.iterations, branch_switched=True)
+            a = lo[0] + lo[2] / (lo[2] - hi[2]) * (hi[0] - lo[0])
+            if below is not None:
+                predicted = lo[1] + (lo[1] - below[1]) * (a - lo[0]) / (lo[0] - below[0])
+            else:
+                predicted = lo[1] + (a - lo[0]) * L * mode
+            model.restore_frames(lo[3])
+            point = solve(predicted, a)
+            if point is None:
+                break
+            if point[2] > 0.0:
+                if side == 1:  # Illinois: the stale end's multiplier halved, so the secant keeps closing in
+                    hi = hi[:2] + (0.5 * hi[2],) + hi[3:]
+                below, lo, side = lo, point, 1
+            else:
+                if side == -1:
+                    lo = lo[:2] + (0.5 * lo[2],) + lo[3:]
+                hi, side = point, -1
+        model.restore_frames(saved)
         return None

@@ -92,6 +92,7 @@ class NewtonResult:
     residual: float
     positive_definite: bool | None
     message: str = ""
+    line_search_trials: int = 0  # shortened steps tried (each an energy or gradient evaluation)
 
 
 def scaled_residual(model, gradient: np.ndarray) -> float:
@@ -107,8 +108,15 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
     equilibria (needed to follow the symmetric branch past a pitchfork); the line search then
     uses the energy where the Hessian is positive definite and the residual elsewhere. With
     minimize=True an indefinite Hessian is shifted to be positive definite (modified Newton),
-    so the iteration descends to a stable equilibrium.
+    so the iteration descends to a stable equilibrium. The result counts the shortened steps
+    the line search tried (line_search_trials).
     """
+    result, trials = _newton(model, q, options, minimize, evaluation)
+    result.line_search_trials = trials
+    return result
+
+
+def _newton(model, q, options, minimize, evaluation):
     options = options or NewtonOptions()
     free = model.free
     rscale = model.residual_scale()[free]
@@ -119,16 +127,17 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
     pd = None
     shift = 0.0
     tiny_steps, stall_residual = 0, np.inf
+    trials = 0
     max_iterations = options.max_iterations * (MINIMIZE_ITERATION_FACTOR if minimize else 1)
     for iteration in range(max_iterations + 1):
         if not np.all(np.isfinite(ev.gradient)):
-            return NewtonResult(q, ev, False, iteration, np.inf, pd, "non-finite gradient")
+            return NewtonResult(q, ev, False, iteration, np.inf, pd, "non-finite gradient"), trials
         r = ev.gradient[free]
         res = float(np.max(np.abs(r / rscale), initial=0.0))
         K = model.free_matrix(ev.hessian)
         pd = K.cholesky()
         if res < residual_tol:
-            return NewtonResult(q, ev, True, iteration, res, pd)
+            return NewtonResult(q, ev, True, iteration, res, pd), trials
         if minimize and not pd:
             # Levenberg-type modification: the smallest tried shift making K + mu I positive definite
             shift = max(shift * 0.25, 1e-8 * K.mean_diagonal())
@@ -149,10 +158,10 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
             if tiny_steps >= STALL_ITERATIONS and res > 0.5 * stall_residual:
                 if res <= ROUNDOFF_STALL_FACTOR * model.residual_floor():
                     # the residual is round-off: q is the equilibrium to within it
-                    return NewtonResult(q, ev, True, iteration, res, pd, "converged to round-off")
+                    return NewtonResult(q, ev, True, iteration, res, pd, "converged to round-off"), trials
                 return NewtonResult(q, ev, False, iteration, res, pd,
                                     f"stalled at scaled residual {res:.3g} (tolerance {residual_tol:.3g}): "
-                                    f"Newton corrections below {options.step_tol:g} for {tiny_steps} iterations")
+                                    f"Newton corrections below {options.step_tol:g} for {tiny_steps} iterations"), trials
             if tiny_steps == 1:
                 stall_residual = res
         else:
@@ -182,19 +191,20 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
                         ev_try = model.evaluate(q_try)
                     break
             alpha *= 0.5
+            trials += 1
         if not accepted:
             if tiny_steps and res <= ROUNDOFF_STALL_FACTOR * model.residual_floor():
                 # a correction below step_tol that no step length improves: the residual is noise
-                return NewtonResult(q, ev, True, iteration, res, pd, "converged to round-off")
-            return NewtonResult(q, ev, False, iteration + 1, res, pd, "line search failed")
+                return NewtonResult(q, ev, True, iteration, res, pd, "converged to round-off"), trials
+            return NewtonResult(q, ev, False, iteration + 1, res, pd, "line search failed"), trials
         if iteration == 0:
             first_residual = res
         if not minimize:
             if options.give_up_after is not None and iteration >= options.give_up_after \
                     and res > options.give_up_ratio * first_residual:
                 return NewtonResult(q, ev, False, iteration + 1, res, pd,
-                                    f"no progress in {options.give_up_after} iterations")
+                                    f"no progress in {options.give_up_after} iterations"), trials
         model.commit(q_try, ev_try)
         q, ev = q_try, ev_try
     res = scaled_residual(model, ev.gradient)
-    return NewtonResult(q, ev, False, max_iterations, res, pd, f"no convergence in {max_iterations} iterations")
+    return NewtonResult(q, ev, False, max_iterations, res, pd, f"no convergence in {max_iterations} iterations"), trials

@@ -36,7 +36,7 @@ def _follower(model, options, switching: bool) -> PathFollower:
     return PathFollower(model, replace(options, branch_switching=switching))
 
 
-def _advance(model, options, snapshot: Snapshot, shear: float, switching: bool) -> State | None:
+def _advance(model, options, snapshot: Snapshot, shear: float, switching: bool, spent: list | None = None) -> State | None:
     model.restore_frames(snapshot.frames)
     follower = _follower(model, options, switching)
     follower._remember(snapshot.state, restart=True)
@@ -44,18 +44,22 @@ def _advance(model, options, snapshot: Snapshot, shear: float, switching: bool) 
         return follower.advance(snapshot.state, snapshot.state.compression, shear)
     except ContinuationFailure:
         return None
+    finally:
+        if spent is not None:
+            spent[0] += follower.newton_iterations
 
 
 def _lambda_min(model, state: State) -> float:
     return float(lowest_modes(model, state.evaluation.hessian, 1)[0])
 
 
-def locate_sign_change(model, options, start: Snapshot, other: float, tolerance: float) -> float | None:
+def locate_sign_change(model, options, start: Snapshot, other: float, tolerance: float,
+                       spent: list | None = None) -> float | None:
     """dW where lambda_min changes sign on the branch through `start`, between start.state.shear
     and `other` (either side), following the branch without switching. None if the branch
     cannot be followed to `other` or lambda_min has the same sign at both ends."""
     a, lam_a = start.state.shear, _lambda_min(model, start.state)
-    end = _advance(model, options, start, other, switching=False)
+    end = _advance(model, options, start, other, switching=False, spent=spent)
     if end is None:
         return None
     b, lam_b = other, _lambda_min(model, end)
@@ -68,7 +72,7 @@ def locate_sign_change(model, options, start: Snapshot, other: float, tolerance:
         # The secant can land on the critical point itself, where the Hessian is singular and
         # Newton may not converge: then try points between the guess and either end.
         for trial in (guess, 0.5 * (guess + a), 0.5 * (guess + b), 0.75 * a + 0.25 * b, 0.25 * a + 0.75 * b):
-            state = _advance(model, options, start, trial, switching=False)
+            state = _advance(model, options, start, trial, switching=False, spent=spent)
             if state is not None:
                 guess = trial
                 break
@@ -88,13 +92,14 @@ def locate_sign_change(model, options, start: Snapshot, other: float, tolerance:
     return (a * lam_b - b * lam_a) / (lam_b - lam_a) if lam_b != lam_a else 0.5 * (a + b)
 
 
-def locate_phase_change(model, options, start: Snapshot, first_after: float, is_after, tolerance: float) -> float | None:
+def locate_phase_change(model, options, start: Snapshot, first_after: float, is_after, tolerance: float,
+                        spent: list | None = None) -> float | None:
     """Smallest dW in (start.state.shear, first_after] whose stable state (branch switching on,
     continued from `start`) satisfies is_after(state); bisection, None if a step fails."""
     lo, hi = start, first_after
     while hi - lo.state.shear > tolerance:
         mid = 0.5 * (lo.state.shear + hi)
-        state = _advance(model, options, lo, mid, switching=True)
+        state = _advance(model, options, lo, mid, switching=True, spent=spent)
         if state is None:
             return None
         if is_after(state):
@@ -107,21 +112,25 @@ def locate_phase_change(model, options, start: Snapshot, first_after: float, is_
 def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | None,
                      last_us: Snapshot | None, first_s: Snapshot | None,
                      tolerances: tuple[float, float] = (1e-4, 1e-3)) -> dict:
-    """dW1, dW2 and dW2_S_stable (in metres; None where not bracketed by the recorded path)."""
+    """dW1, dW2 and dW2_S_stable (in metres; None where not bracketed by the recorded path), and
+    "newton_iterations": those spent locating them."""
     from ..observables import phase_label
 
     L = model.strip.length
     saved = model.save_frames()
     out = {"dW1": None, "dW2": None, "dW2_S_stable": None}
+    spent = [0]
     try:
         if last_u is not None and first_us is not None:
-            out["dW1"] = locate_sign_change(model, options, last_u, first_us, tolerances[0] * L)
+            out["dW1"] = locate_sign_change(model, options, last_u, first_us, tolerances[0] * L, spent)
         if last_us is not None and first_s is not None:
             def in_s(state):
                 return phase_label(model, state.q, state.compression, state.shear).startswith("S")
 
-            out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L)
-            out["dW2_S_stable"] = locate_sign_change(model, options, first_s, last_us.state.shear, tolerances[1] * L)
+            out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L,
+                                               spent)
+            out["dW2_S_stable"] = locate_sign_change(model, options, first_s, last_us.state.shear, tolerances[1] * L, spent)
     finally:
         model.restore_frames(saved)
+        out["newton_iterations"] = spent[0]
     return out

@@ -16,7 +16,7 @@ import numpy as np
 
 def compile_kernels() -> dict:
     """Run every kernel once; returns the seconds spent per group (compiling where not cached)."""
-    from .energies.hinge_bending import hinge_bending_energy
+    from .energies.hinge_bending import hinge_bending_energy, triangle_normals
     from .energies.rod_curvature import material_curvatures, strain_derivatives
     from .energies.stretch import stretching_energy
     from .geometry.frames import parallel_transport, reference_twist
@@ -58,6 +58,7 @@ def compile_kernels() -> dict:
             stretching_energy(t, np.ones(len(t)), 1.0, gradient=gradient, hessian=hessian)
         plate = PlateModel(strip, 40)
         xp = plate.reset().reshape(-1, 3)
+        triangle_normals(xp, plate.mesh.triangles)
         for gradient, hessian in ((False, False), (True, False), (True, True)):
             hinge_bending_energy(xp, plate.mesh.triangles, plate.mesh.hinge_triangles, plate.hinge_stiffness,
                                  gradient=gradient, hessian=hessian)

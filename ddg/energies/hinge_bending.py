@@ -213,12 +213,19 @@ def add_hinge_terms(x, triangles, hinge_triangles, stiffness, n_dof, grad, band,
 
 
 # ---------------------------------------------------------------------------- array interface
+@njit(cache=True)
+def _normals(x, triangles):
+    normals = np.empty((triangles.shape[0], 3))
+    double_area = np.empty(triangles.shape[0])
+    for t in range(triangles.shape[0]):
+        double_area[t] = triangle_normal(x, triangles[t], normals[t])
+    return normals, double_area
+
+
 def triangle_normals(x: np.ndarray, triangles: np.ndarray):
-    """Unit normals (T, 3) and doubled areas |u| (T,) of the deformed triangles."""
-    p = x[triangles]
-    u = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
-    double_area = np.linalg.norm(u, axis=1)
-    return u / double_area[:, None], double_area
+    """Unit normals (T, 3) and doubled areas |u| (T,) of the deformed triangles (the kernel's
+    triangle_normal, for analysis: resolution indicators, curvatures)."""
+    return _normals(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(triangles, dtype=np.int64))
 
 
 def hinge_bending_energy(x: np.ndarray, triangles: np.ndarray, hinge_triangles: np.ndarray, stiffness: np.ndarray,

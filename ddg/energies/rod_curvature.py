@@ -39,7 +39,6 @@ import math
 import numpy as np
 from numba import njit
 
-from ..solve.band_scatter import add_symmetric_block
 
 #: Strain order in every (n, 3) array of this module: out-of-plane curvature, geodesic curvature, twist.
 KAPPA_N, KAPPA_G, TAU = 0, 1, 2
@@ -286,7 +285,6 @@ def add_stencil_terms(x, m1, m2, first, second, first_offset, n_dof, grad, band,
     eth = np.empty((3, 2))
     fth = np.empty((3, 2))
     thth = np.empty(2)
-    dofs = np.empty(STENCIL_SIZE, dtype=np.int64)
     for i in range(x.shape[0] - 2):
         _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1],
                  strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w)
@@ -309,15 +307,17 @@ def add_stencil_terms(x, m1, m2, first, second, first_offset, n_dof, grad, band,
         for j in range(2):
             thth[j] = w0 * hthth[0, j] + w1 * hthth[1, j] + w2 * hthth[2, j]
         _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, h11)
+        # the stencil's DOFs are contiguous (base .. base + 10): entry (a, b), a >= b, of its
+        # Hessian lands at band[(a - b) * n + base + b]; only the lower triangle is formed
         for c in range(3):
             for d in range(3):
                 coefficient = second[i, c, d]
                 if coefficient != 0.0:
                     for a in range(STENCIL_SIZE):
                         ga = coefficient * g11[c, a]
-                        for b in range(STENCIL_SIZE):
+                        for b in range(a + 1):
                             h11[a, b] += ga * g11[d, b]
         for a in range(STENCIL_SIZE):
-            dofs[a] = base + a
-        add_symmetric_block(band, n_dof, dofs, h11)
+            for b in range(a + 1):
+                band[(a - b) * n_dof + base + b] += h11[a, b]
 

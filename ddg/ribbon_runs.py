@@ -153,6 +153,8 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     except Exception as exc:  # noqa: BLE001
         error = exc
     summary["newton_iterations"] = follower.newton_iterations + relax_iterations
+    summary["newton_iterations_by_phase"] = {**follower.iterations_by_phase,
+                                             "line search trials": follower.line_search_trials}
     summary["wall_time_s"] = time.perf_counter() - t0
     finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
                    stage=stage, error=error)
@@ -170,6 +172,7 @@ def rod_thresholds(summary: dict, rod, options: ContinuationOptions, brackets: d
     for key in ("dW1_over_L", "dW2_over_L", "dW2_S_stable_over_L"):
         summary[f"rod_{key}"] = found[key]
     summary["threshold_wall_time_s"] = found["threshold_wall_time_s"]
+    summary["threshold_newton_iterations"] = found["threshold_newton_iterations"]
     summary["warnings"].extend(f"rod: {w}" for w in found["warnings"])
 
 

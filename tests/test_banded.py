@@ -59,3 +59,32 @@ def test_scatter_sums_overlapping_blocks_into_the_band():
     np.add.at(pair, (rows[:, None], cols[None, :]), cross)
     dense += pair + pair.T
     assert np.allclose(SymmetricBanded(band.reshape(bandwidth + 1, n)).to_dense(), dense, rtol=1e-14, atol=1e-14)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_lanczos_lowest_eigenvalue_from_the_cholesky_factor(seed):
+    """lambda_min of K v = lambda D v from K's banded Cholesky factor (ddg.solve.lanczos) equals the
+    dense value, also when the lowest mode is orthogonal to a constant vector (a mirror-symmetric
+    K whose lowest mode is antisymmetric, as on the U branch at a pitchfork)."""
+    from ddg.solve.lanczos import lowest_eigenvalue
+
+    n, bandwidth = 120, 6
+    K = random_banded(n, bandwidth, 1.0, seed=seed)
+    dense = K.to_dense()
+    flip = np.eye(n)[::-1]
+    dense = 0.5 * (dense + flip @ dense @ flip)  # mirror symmetric
+    x = np.linspace(-1.0, 1.0, n)
+    odd = x / np.linalg.norm(x)  # antisymmetric, made the lowest mode with eigenvalue 0.05
+    dense = dense - (odd @ dense @ odd - 0.05) * np.outer(odd, odd)
+    dense = 0.5 * (dense + dense.T)
+    band = np.zeros((n - 1 + 1, n))
+    for d in range(n):
+        band[d, : n - d] = np.diag(dense, -d)
+    K = SymmetricBanded(band)
+    assert K.cholesky()
+    metric = np.random.default_rng(seed).uniform(0.5, 2.0, n)
+    metric = 0.5 * (metric + metric[::-1])
+    scaled = dense / np.sqrt(np.outer(metric, metric))
+    reference = np.linalg.eigvalsh(scaled)[0]
+    assert abs(odd @ np.ones(n)) < 1e-12
+    assert lowest_eigenvalue(K._cholesky, metric) == pytest.approx(reference, rel=1e-10)

@@ -8,10 +8,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from .lanczos import lowest_eigenvalue
+
 
 def lowest_modes(model, hessian, count: int = 1, vectors: bool = False):
-    """Normalised lowest eigenvalues (and eigenvectors in DOF space) of the free-DOF Hessian."""
+    """Normalised lowest eigenvalues (and eigenvectors in DOF space) of the free-DOF Hessian.
+
+    The lowest eigenvalue alone of a positive definite Hessian comes from the Cholesky factor
+    Newton already computed (ddg.solve.lanczos); other requests, and a Lanczos that does not
+    converge, use ARPACK's shift-invert Lanczos on the scaled matrix."""
     metric, unit = model.eigenvalue_metric()
+    if count == 1 and not vectors:
+        K = model.free_matrix(hessian)
+        if K.cholesky():
+            lam = lowest_eigenvalue(K._cholesky, metric)
+            if lam is not None:
+                return np.array([lam / unit])
     s = 1.0 / np.sqrt(metric)
     K = model.free_matrix(hessian).scaled(s)
     if vectors:

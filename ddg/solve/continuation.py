@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..geometry.strip import InputError
-from .newton import NewtonOptions, check_option, newton
+from .newton import ROUNDOFF_STALL_FACTOR, NewtonOptions, check_option, newton
 from .stability import lowest_modes
 
 
@@ -436,8 +436,10 @@ class PathFollower:
         ww = float(w @ w)
         rscale = model.residual_scale()[free]
         tol = max(self.options.newton.residual_tol, model.residual_floor())
+        lscale = model.length_scale()[free]
+        roundoff = ROUNDOFF_STALL_FACTOR * model.residual_floor()
         q = q.copy()
-        mu, first = 0.0, None
+        mu, first, correction = 0.0, None, np.inf
         ev = model.evaluate(q)
         for iteration in range(self.options.newton.max_iterations + 1):
             r = ev.gradient[free] + mu * w
@@ -445,7 +447,10 @@ class PathFollower:
             res = float(np.max(np.abs(r / rscale)))
             if not np.isfinite(res):
                 return None
-            if res < tol and abs(c) < 1e-12 * self._length:
+            # converged, or converged to round-off as newton() judges it (a correction below
+            # step_tol with the residual within ROUNDOFF_STALL_FACTOR of the model's floor)
+            if (res < tol or (correction < self.options.newton.step_tol and res <= roundoff)) \
+                    and abs(c) < 1e-12 * self._length:
                 return q, ev, mu
             first = res if first is None else first
             if iteration == self.options.newton.max_iterations or res > 1e3 * first:
@@ -453,7 +458,9 @@ class PathFollower:
             K = model.free_matrix(ev.hessian)
             x1, x2 = K.solve(np.column_stack([-r, w])).T
             dmu = (float(w @ x1) + c * ww) / float(w @ x2)
-            q[free] += x1 - dmu * x2
+            dq = x1 - dmu * x2
+            correction = float(np.max(np.abs(dq / lscale)))
+            q[free] += dq
             mu += dmu
             ev = model.evaluate(q)
             self._spent(1, "branch switching")

@@ -24,6 +24,8 @@ def compile_kernels() -> dict:
     from .models.plate import PlateModel
     from .models.ribbon import RibbonModel
     from .models.rod import RodModel
+    from .solve.banded import SymmetricBanded
+    from .solve.lanczos import lowest_eigenvalue
 
     strip = Strip.from_ratios(1 / 6, 0.5)
     rng = np.random.default_rng(0)
@@ -59,6 +61,16 @@ def compile_kernels() -> dict:
         plate = PlateModel(strip, 40)
         xp = plate.reset().reshape(-1, 3)
         triangle_normals(xp, plate.mesh.triangles)
+        # linear algebra: Lanczos on the Cholesky factor, LDL^T of an indefinite band (both paths)
+        for bandwidth in (3, 40):
+            band = np.zeros((bandwidth + 1, 60))
+            band[0] = np.linspace(-1.0, 3.0, 60)
+            band[1, :-1] = 0.1
+            SymmetricBanded(band).solve(np.ones(60))
+            band[0] += 2.0
+            spd = SymmetricBanded(band)
+            if spd.cholesky():
+                lowest_eigenvalue(spd._cholesky, np.ones(60))
         for gradient, hessian in ((False, False), (True, False), (True, True)):
             hinge_bending_energy(xp, plate.mesh.triangles, plate.mesh.hinge_triangles, plate.hinge_stiffness,
                                  gradient=gradient, hessian=hessian)

@@ -7,6 +7,7 @@ as they compute it, so no per-element block arrays are formed in the assembled e
 """
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 
@@ -46,3 +47,18 @@ def add_pair_block(band, n, rows, cols, block):
                 band[(c - r) * n + r] += block[a, b]
             else:
                 band[c] += 2.0 * block[a, b]
+
+
+@njit(cache=True)
+def band_matvec(band, x):
+    """y = A x for the symmetric matrix in lower band storage band (bandwidth + 1, n)."""
+    n = band.shape[1]
+    y = np.empty(n)
+    for j in range(n):
+        y[j] = band[0, j] * x[j]
+    for d in range(1, band.shape[0]):
+        for j in range(n - d):
+            v = band[d, j]
+            y[j + d] += v * x[j]
+            y[j] += v * x[j + d]
+    return y

@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from .band_scatter import band_matvec
+
 
 class SymmetricBanded:
     """A symmetric matrix in lower band storage with the operations the solvers need."""
@@ -49,12 +51,7 @@ class SymmetricBanded:
         return out
 
     def matvec(self, x: np.ndarray) -> np.ndarray:
-        y = self.band[0] * x
-        for d in range(1, self.band.shape[0]):
-            col = self.band[d, : self.n - d]
-            y[d:] += col * x[: self.n - d]
-            y[: self.n - d] += col * x[d:]
-        return y
+        return band_matvec(np.ascontiguousarray(self.band), np.ascontiguousarray(x, dtype=float))
 
     def cholesky(self) -> bool:
         """Try a banded Cholesky; success proves the matrix positive definite."""
@@ -70,9 +67,38 @@ class SymmetricBanded:
     def positive_definite(self) -> bool:
         return self.cholesky()
 
+    def ldlt(self):
+        """A = L D L^T without pivoting (ddg.solve.band_ldlt), cached; for indefinite matrices."""
+        if getattr(self, "_ldlt", None) is None:
+            from .band_ldlt import BandLDLT
+
+            self._ldlt = BandLDLT(self.band)
+        return self._ldlt
+
+    def inertia(self):
+        """(negative, zero, positive) eigenvalue counts from the LDL^T pivots (Sylvester's law);
+        raises band_ldlt.UnreliablePivot where a pivot is zero to rounding."""
+        if self.cholesky():
+            return (0, 0, self.n)
+        return tuple(self.ldlt().inertia())
+
+    #: An LDL^T solve (no pivoting) is kept when its relative residual is below this; else banded LU.
+    LDLT_RESIDUAL = 1e-8
+
     def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """A^-1 rhs: banded Cholesky where A is positive definite; otherwise LDL^T without pivoting
+        (about the Cholesky's cost; on the plate's indefinite Hessians 3-4 times cheaper than banded
+        LU), checked by its residual, and banded LU (partial pivoting) where that check fails."""
         if self.cholesky():
             return sla.cho_solve_banded((self._cholesky, True), rhs, check_finite=False)
+        ldlt = self.ldlt()
+        if ldlt.reliable:
+            x = ldlt.solve(rhs)
+            columns = (x,) if x.ndim == 1 else x.T
+            targets = (rhs,) if x.ndim == 1 else np.asarray(rhs).T
+            if all(np.all(np.isfinite(c)) and np.linalg.norm(self.matvec(c) - b) <= self.LDLT_RESIDUAL * np.linalg.norm(b)
+                   for c, b in zip(columns, targets)):
+                return x
         u = self.band.shape[0] - 1
         full = np.zeros((2 * u + 1, self.n))
         full[u:] = self.band

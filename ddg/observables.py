@@ -14,7 +14,7 @@ from .solve.stability import lowest_modes
 
 PATH_COLUMNS = ("stage", "dL_over_L", "dW_over_L", "H_mid_over_L", "F_shear_norm", "energy", "lambda_min", "phase")
 EXTRA_COLUMNS = ("F_axial_norm", "stable", "newton_iterations", "branch_switched", "max_turn_angle_deg",
-                 "max_strain")
+                 "max_strain", "negative_eigenvalues")
 
 #: Beyond this angle between neighbouring elements (edges of the rod, triangles of the plate) the
 #: discretisation no longer resolves the shape (e.g. the conical singularities that form at the
@@ -87,7 +87,20 @@ def observe(model, state, stage: str, eigenvalues: bool = True) -> dict:
         "newton_iterations": int(state.iterations),
         "branch_switched": bool(state.branch_switched),
         **model.resolution_indicators(state.q),
+        "negative_eigenvalues": negative_eigenvalues(model, ev.hessian),
     }
+
+
+def negative_eigenvalues(model, hessian) -> int | None:
+    """The number of unstable directions of an equilibrium: negative eigenvalues of the free-DOF
+    Hessian, 0 where its Cholesky succeeds, else the negative pivots of its LDL^T (Sylvester's law
+    of inertia; ddg.solve.band_ldlt). None where a pivot is zero to rounding (a critical point)."""
+    from .solve.band_ldlt import UnreliablePivot
+
+    try:
+        return int(model.free_matrix(hessian).inertia()[0])
+    except UnreliablePivot:
+        return None
 
 
 #: Largest stretching strain of a resolved state: the strips are inextensible to ~1e-4 (bending

@@ -53,6 +53,19 @@ def test_states_reported_stable_on_any_branch_have_positive_lambda_min(which, re
     assert any(not r["stable"] for r in result.branch_rows)  # the unstable parts are there
 
 
+@pytest.mark.parametrize("which", ["rod", "narrow_plate"])
+def test_the_number_of_unstable_directions_is_the_inertia_of_the_hessian(which, request):
+    """negative_eigenvalues (the negative pivots of the LDL^T, Sylvester's law) is 0 exactly on the
+    stable states; past a pitchfork of U or before S becomes stable it is 1: one critical mode."""
+    result = request.getfixturevalue(which)
+    for rows in (result.rows, result.branch_rows):
+        for r in rows:
+            assert (r["negative_eigenvalues"] == 0) == bool(r["stable"]), r
+    unstable_u = [r["negative_eigenvalues"] for r in branch(result, "U") if not r["stable"]]
+    assert unstable_u and set(unstable_u) <= {1, 2}
+    assert unstable_u[0] == 1  # the first unstable U states: the pitchfork's one mode
+
+
 def test_U_branch_turns_unstable_at_dW1_and_matches_natural_continuation(rod):
     """The arclength trace of U changes stability where the thresholds module puts dW1, and it
     lies on the same equilibria as the recorded path (which follows U up to dW1)."""

@@ -26,6 +26,22 @@ class BandedModel:
     free: slice
     constrained: np.ndarray
 
+    def _accumulators(self, gradient: bool, hessian: bool) -> tuple[np.ndarray, np.ndarray]:
+        """Zeroed gradient and flattened lower band for the compiled kernels to add into (empty
+        where not asked)."""
+        n = self.n_dof
+        return (np.zeros(n) if gradient else np.empty(0),
+                np.zeros((self.bandwidth + 1) * n) if hessian else np.empty(0))
+
+    def _evaluation(self, parts: dict, grad: np.ndarray, band: np.ndarray, gradient: bool, hessian: bool,
+                    frames=None) -> Evaluation:
+        out = Evaluation(energy=sum(parts.values()), parts=parts, frames=frames)
+        if gradient:
+            out.gradient = grad
+        if hessian:
+            out.hessian = SymmetricBanded(band.reshape(self.bandwidth + 1, self.n_dof))
+        return out
+
     def apply_clamps(self, q: np.ndarray, compression: float, shear: float) -> np.ndarray:
         q = q.copy()
         q[self.constrained] = self.clamp_values(compression, shear)

@@ -32,7 +32,6 @@ from ..energies.stretch import add_edge_terms
 from ..geometry.centerline import first_mode_profile
 from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, structured_mesh
 from ..geometry.strip import InputError, Strip
-from ..solve.banded import SymmetricBanded
 from .base import BandedModel, Evaluation
 
 
@@ -172,19 +171,13 @@ class PlateModel(BandedModel):
         x = q.reshape(-1, 3)
         hessian = hessian and gradient
         n = self.n_dof
-        grad = np.zeros(n) if gradient else np.empty(0)
-        band = np.zeros((self.bandwidth + 1) * n) if hessian else np.empty(0)
+        grad, band = self._accumulators(gradient, hessian)
         stretching = add_edge_terms(x, self._edges, self.rest_edge_lengths, self.stretch_stiffness, 3, n,
                                     grad, band, gradient, hessian)
         bending = add_hinge_terms(x, self._triangles, self._hinge_triangles, self.hinge_stiffness, n,
                                   grad, band, gradient, hessian)
         parts = {"stretching": float(stretching), "bending": float(bending)}
-        out = Evaluation(energy=parts["stretching"] + parts["bending"], parts=parts)
-        if gradient:
-            out.gradient = grad
-        if hessian:
-            out.hessian = SymmetricBanded(band.reshape(self.bandwidth + 1, n))
-        return out
+        return self._evaluation(parts, grad, band, gradient, hessian)
 
     # ------------------------------------------------------------------ metrics and scales
     def eigenvalue_metric(self) -> tuple[np.ndarray, float]:

@@ -19,7 +19,6 @@ from ..energies.stretch import add_edge_terms
 from ..geometry.centerline import Centerline
 from ..geometry.frames import rod_frames
 from ..geometry.strip import Strip
-from ..solve.banded import SymmetricBanded
 from .base import BandedModel, Evaluation
 
 __all__ = ["RodModel", "Evaluation"]
@@ -146,18 +145,13 @@ class RodModel(BandedModel):
         parts, first, second = self.stencil_density(kappa_n, kappa_g, tau)
         hessian = hessian and gradient
         n = self.n_dof
-        grad = np.zeros(n) if gradient else np.empty(0)
-        band = np.zeros((self.bandwidth + 1) * n) if hessian else np.empty(0)
+        grad, band = self._accumulators(gradient, hessian)
         stretching = add_edge_terms(x, self._edge_nodes, self.rest_edge_lengths, self.stretch_stiffness, 4, n,
                                     grad, band, gradient, hessian)
-        parts = {"stretching": float(stretching), **parts}
-        out = Evaluation(energy=sum(parts.values()), parts=parts, frames=(t, d1, m_ref))
         if gradient:
             add_stencil_terms(x, m1, m2, first, second, 0, n, grad, band, hessian)
-            out.gradient = grad
-        if hessian:
-            out.hessian = SymmetricBanded(band.reshape(self.bandwidth + 1, n))
-        return out
+        return self._evaluation({"stretching": float(stretching), **parts}, grad, band, gradient, hessian,
+                                frames=(t, d1, m_ref))
 
     def stencil_density(self, kappa_n: np.ndarray, kappa_g: np.ndarray, tau: np.ndarray):
         """Bending (Eq. 6b) and twisting (Eq. 6c) of the interior nodes as functions of the strains:

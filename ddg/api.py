@@ -472,8 +472,7 @@ def simulate(
     except Exception as exc:  # noqa: BLE001
         error = exc
     summary["newton_iterations"] = follower.newton_iterations
-    summary["newton_iterations_by_phase"] = {**follower.iterations_by_phase,
-                                             "line search trials": follower.line_search_trials}
+    summary["newton_iterations_by_phase"] = follower.iteration_breakdown()
     summary["folds_dW_over_L"] = _distinct([abs(f) / L for f in follower.folds], 1e-4)
     summary["wall_time_s"] = time.perf_counter() - t0
     finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,

@@ -153,8 +153,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     except Exception as exc:  # noqa: BLE001
         error = exc
     summary["newton_iterations"] = follower.newton_iterations + relax_iterations
-    summary["newton_iterations_by_phase"] = {**follower.iterations_by_phase,
-                                             "line search trials": follower.line_search_trials}
+    summary["newton_iterations_by_phase"] = follower.iteration_breakdown()
     summary["wall_time_s"] = time.perf_counter() - t0
     finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
                    stage=stage, error=error)

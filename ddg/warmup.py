@@ -70,7 +70,7 @@ def compile_kernels() -> dict:
             band[0] += 2.0
             spd = SymmetricBanded(band)
             if spd.cholesky():
-                lowest_eigenvalue(spd._cholesky, np.ones(60))
+                lowest_eigenvalue(spd.cholesky_factor, np.ones(60))
         for gradient, hessian in ((False, False), (True, False), (True, True)):
             hinge_bending_energy(xp, plate.mesh.triangles, plate.mesh.hinge_triangles, plate.hinge_stiffness,
                                  gradient=gradient, hessian=hessian)

@@ -87,4 +87,4 @@ def test_lanczos_lowest_eigenvalue_from_the_cholesky_factor(seed):
     scaled = dense / np.sqrt(np.outer(metric, metric))
     reference = np.linalg.eigvalsh(scaled)[0]
     assert abs(odd @ np.ones(n)) < 1e-12
-    assert lowest_eigenvalue(K._cholesky, metric) == pytest.approx(reference, rel=1e-10)
+    assert lowest_eigenvalue(K.cholesky_factor, metric) == pytest.approx(reference, rel=1e-10)

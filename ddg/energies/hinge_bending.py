@@ -42,15 +42,6 @@ from numba import njit
 from ..solve.band_scatter import add_pair_block, add_symmetric_block
 
 
-def cross_matrix(v: np.ndarray) -> np.ndarray:
-    """[v]x for a stack of vectors (..., 3) -> (..., 3, 3), with [v]x w = v x w."""
-    m = np.zeros(v.shape[:-1] + (3, 3))
-    m[..., 0, 1], m[..., 0, 2] = -v[..., 2], v[..., 1]
-    m[..., 1, 0], m[..., 1, 2] = v[..., 2], -v[..., 0]
-    m[..., 2, 0], m[..., 2, 1] = -v[..., 1], v[..., 0]
-    return m
-
-
 def hinge_stiffness(rest_edge_lengths: np.ndarray, rest_pair_areas: np.ndarray, bending_stiffness: float) -> np.ndarray:
     """Per-hinge coefficient c_h giving the continuum plate bending stiffness D.
 

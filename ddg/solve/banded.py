@@ -64,6 +64,11 @@ class SymmetricBanded:
         return self._cholesky is not None
 
     @property
+    def cholesky_factor(self) -> np.ndarray | None:
+        """The lower band Cholesky factor (LAPACK storage), or None if A is not positive definite."""
+        return self._cholesky if self.cholesky() else None
+
+    @property
     def positive_definite(self) -> bool:
         return self.cholesky()
 

@@ -101,6 +101,11 @@ class PathFollower:
         self.iterations_by_phase: dict[str, int] = dict.fromkeys(PHASES, 0)
         self.line_search_trials = 0  # shortened Newton steps tried in load steps (evaluations, not iterations)
 
+    def iteration_breakdown(self) -> dict[str, int]:
+        """Newton iterations per phase and the line search's shortened steps (summary.json's
+        newton_iterations_by_phase)."""
+        return {**self.iterations_by_phase, "line search trials": self.line_search_trials}
+
     def _spent(self, iterations: int, phase: str) -> None:
         self.newton_iterations += iterations
         self.iterations_by_phase[phase] += iterations

@@ -26,7 +26,7 @@ def lowest_modes(model, hessian, count: int = 1, vectors: bool = False):
         # solves lose to ARPACK with LAPACK's (eigen time per iteration 3.1 -> 4.1 ms at 5740
         # triangles, measured)
         if K.band.shape[0] - 1 <= LANCZOS_MAX_BANDWIDTH and K.cholesky():
-            lam = lowest_eigenvalue(K._cholesky, metric)
+            lam = lowest_eigenvalue(K.cholesky_factor, metric)
             if lam is not None:
                 return np.array([lam / unit])
     s = 1.0 / np.sqrt(metric)

@@ -39,7 +39,7 @@ from collections import defaultdict
 from fractions import Fraction
 from pathlib import Path
 
-from ddg.io import atomic_write_text
+from ddg.output.io import atomic_write_text
 
 CHANGED_NOTE = " (CHANGED during the run: runs may mix library versions)"
 

@@ -64,7 +64,6 @@ import os
 import statistics
 import sys
 import time
-import traceback
 from pathlib import Path
 
 import numpy as np

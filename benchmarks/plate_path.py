@@ -37,7 +37,7 @@ inclusive times, split by the category of the enclosing call, are kept in the JS
 calls they time.
 
 Writes OUT/plate_path.json (all numbers, per-step detail and machine info) and OUT/plate_path.md
-(the tables), both atomically (ddg.io.atomic_write_text). Not part of the test run.
+(the tables), both atomically (ddg.output.io.atomic_write_text). Not part of the test run.
 """
 from __future__ import annotations
 

@@ -134,7 +134,7 @@ class _Instrument(PathInstrument):
 # ---------------------------------------------------------------------------- one run (child)
 def _run_once(nodes: int) -> dict:
     import ddg
-    from ddg.analytic import clamped_elastica_midpoint_height
+    from ddg.analysis.analytic import clamped_elastica_midpoint_height
 
     fingerprint = source_fingerprint()
     inst = _Instrument()
@@ -272,7 +272,7 @@ def markdown_report(report: dict) -> str:
         "Time split columns (share of the wall time): eval = " + CATEGORY_LABELS["evaluate"] + "; linalg = "
         + CATEGORY_LABELS["linalg"] + "; eig = " + CATEGORY_LABELS["eigen"] + " (including its own factorisations "
         "and Lanczos solves); other = " + CATEGORY_LABELS["other"] + ". The relative error compares H_mid/L at the "
-        "end of compression with `ddg.analytic.clamped_elastica_midpoint_height(0.5)` = "
+        "end of compression with `ddg.analysis.analytic.clamped_elastica_midpoint_height(0.5)` = "
         f"{report['H_mid_over_L_exact']:.8f}.",
         "",
         f"- growth exponent d log(wall time) / d log(M) over M = {sc['nodes_fitted']}: " + slopes_markdown(sc)
@@ -300,7 +300,7 @@ def main(argv=None) -> int:
         parser.error("--repeat must be >= 1 and every M >= 5")
     timeout = args.timeout if args.timeout > 0 else None
 
-    from ddg.analytic import clamped_elastica_midpoint_height
+    from ddg.analysis.analytic import clamped_elastica_midpoint_height
 
     provenance = Provenance()
     results = [

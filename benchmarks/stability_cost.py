@@ -23,7 +23,7 @@ import os
 import time
 from pathlib import Path
 
-from ddg.io import atomic_write_text
+from ddg.output.io import atomic_write_text
 
 DEFAULT_CASES = ("rod:100", "plate:2000")
 

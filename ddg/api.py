@@ -12,9 +12,10 @@ import numpy as np
 import scipy
 
 from .geometry.strip import InputError, LoadingProtocol, Strip
-from .io import write_centerline_csv, write_path_csv, write_summary_json
-from .observables import observe, resolved_up_to
+from .output.io import write_centerline_csv, write_path_csv, write_summary_json
+from .analysis.observables import observe, resolved_up_to
 from .solve.continuation import ContinuationFailure, ContinuationOptions, PathFollower
+from .solve.state import Snapshot
 
 DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "ribbon": 101}  # ribbon: M not a multiple of 4, see RibbonModel
 
@@ -50,7 +51,7 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
 
 
 def _frame_writer(model, directory: Path):
-    from .frames_output import FrameWriter, polyline_cells
+    from .output.frames import FrameWriter, polyline_cells
 
     if hasattr(model, "mesh"):
         return FrameWriter(directory, model.mesh)
@@ -119,8 +120,6 @@ class ProgressBar:
 
 def track_brackets(brackets: dict, model, state, phase: str) -> None:
     """Remember the recorded states that bracket the phase changes U -> US and US -> S."""
-    from .solve.thresholds import Snapshot
-
     if phase == "U" and brackets["first_us"] is None:
         brackets["last_u"] = Snapshot.take(model, state)
     elif phase.startswith("US"):
@@ -150,9 +149,9 @@ THRESHOLD_KEYS = ("dW1_over_L", "dW2_over_L", "dW2_S_stable_over_L")
 
 def check_thresholds_resolved(summary: dict, rows: list[dict]) -> None:
     """Null every threshold located from states the discretisation does not resolve
-    (ddg.observables.unresolved_reason); its value and the reason go to
+    (ddg.analysis.observables.unresolved_reason); its value and the reason go to
     `unresolved_thresholds`, a line to `warnings`. No threshold is printed from such a state."""
-    from .observables import unresolved_reason
+    from .analysis.observables import unresolved_reason
 
     for key in THRESHOLD_KEYS:
         value = summary.get(key)
@@ -178,7 +177,7 @@ def trace_all_branches(summary: dict, model, options, compressed, shear_max: flo
     summary["branches"] = diagram.summary(model.strip.length)
     summary["branches_newton_iterations"] = diagram.newton_iterations
     summary["branches_wall_time_s"] = time.perf_counter() - t0
-    return diagram.rows()
+    return [{"branch": b.name, **observe(model, s, "shear", True)} for b in diagram.branches for s in b.states]
 
 
 def _distinct(values: list[float], tolerance: float) -> list[float]:
@@ -282,8 +281,8 @@ def finish_summary(summary: dict, rows: list[dict], *, path_complete: bool, stop
     path_complete: the loading path reached its end; stopped: the ContinuationFailure message if
     it did not; interrupted: the KeyboardInterrupt (SIGINT/SIGTERM) that stopped the run, in
     `stage`; error: an unexpected exception."""
-    from .interrupts import signal_name_of
-    from .io import STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED
+    from .output.interrupts import signal_name_of
+    from .output.io import STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED
 
     summary["path_complete"] = bool(path_complete)
     summary["recorded_steps"] = len(rows)
@@ -318,7 +317,7 @@ def open_run_folder(out, summary: dict, trailing: tuple[str, ...] = ()):
     """The RunFolder of `out` (None if out is None), marked in progress with this summary."""
     if out is None:
         return None
-    from .io import RunFolder
+    from .output.io import RunFolder
 
     return RunFolder(out, summary, trailing=trailing)
 
@@ -380,7 +379,7 @@ def simulate(
     resolution = check_resolution(model, resolution, strip, mesh)
     shear_ratio = protocol.resolved_shear_ratio(strip)
     if out is not None:
-        from .io import check_output_directory
+        from .output.io import check_output_directory
 
         check_output_directory(out)
     if solver == "dynamic":
@@ -438,8 +437,6 @@ def simulate(
             state = follower.start_compression(target) if k == 1 else follower.advance(state, target, 0.0)
             record("compression")
         summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
-        from .solve.thresholds import Snapshot
-
         compressed = Snapshot.take(instance, state)
         if folder is not None:
             folder.checkpoint({**summary, "message": "running: compression complete, shearing"})

@@ -1,5 +1,5 @@
 """Command line: `python -m ddg simulate ...`, a thin layer over ddg.simulate; `python -m ddg
-curvatures ...` and `python -m ddg centerline-error ...` (ddg.curvatures, ddg.centerline_approx).
+curvatures ...` and `python -m ddg centerline-error ...` (ddg.analysis.curvatures, ddg.analysis.centerline_approx).
 
 Exit codes: 0 path complete; 2 bad arguments (one-line message, before any work); 3 the run
 stopped converging (the converged part of the path is written, the message says where); 130 or
@@ -96,6 +96,12 @@ def build_parser() -> argparse.ArgumentParser:
     err.add_argument("--slenderness", type=float, default=None, help="L/b (default: b = 0.127 mm)")
     err.add_argument("--resolution", type=int, default=800, help="target triangle count (default 800)")
     err.add_argument("--out", default="out", help="output directory: centerline_error.csv, .png (default ./out)")
+    from .output import render_command
+    from .sweep import command as sweep_command
+
+    sweep_command.add_arguments(sub.add_parser(
+        "sweep", help="a grid of runs (W/L, dL/L, L/b, resolution, model) as Dask tasks: one table and a phase diagram"))
+    render_command.add_arguments(sub.add_parser("render", help="draw a run's frames (PNG, HTML scene) with pyvista"))
     return parser
 
 
@@ -104,7 +110,7 @@ MAX_LIST_VALUES = 50
 
 
 def _ratios(name: str, text: str, low: float, high: float, low_inclusive: bool = False) -> list[float]:
-    from .centerline_approx import check_ratios
+    from .analysis.centerline_approx import check_ratios
 
     values = [v for v in str(text).split(",") if v.strip()] or [text]
     if len(values) > MAX_LIST_VALUES:
@@ -133,7 +139,7 @@ def _check_zeta(zeta) -> None:
 
 
 def _output_directory(out) -> Path:
-    from .io import check_output_directory
+    from .output.io import check_output_directory
 
     return check_output_directory(out, "--out")
 
@@ -147,7 +153,7 @@ def _require_extra(module: str, extra: str) -> None:
 
 def cmd_curvatures(args) -> int:
     """Curvature profiles at the requested shears: OUT/curvatures.csv and OUT/curvatures.png."""
-    from .curvatures import centerline_curvatures, inflection_jumps, states_at_shears, write_curvatures_csv
+    from .analysis.curvatures import centerline_curvatures, inflection_jumps, states_at_shears, write_curvatures_csv
 
     from .api import check_resolution
     from .limits import check_integer
@@ -206,8 +212,8 @@ def cmd_centerline_error(args) -> int:
     import csv
     import io as _io
 
-    from .centerline_approx import centerline_error_study
-    from .io import atomic_write_text
+    from .analysis.centerline_approx import centerline_error_study
+    from .output.io import atomic_write_text
 
     from .api import check_resolution
 
@@ -320,7 +326,7 @@ def main(argv=None) -> int:
     import os
     import signal as _signal
 
-    from .interrupts import exit_code_of, signal_name_of, terminate_as_interrupt
+    from .output.interrupts import exit_code_of, signal_name_of, terminate_as_interrupt
     from .solve.continuation import ContinuationFailure
 
     previous = {sig: _signal.getsignal(sig) for sig in (_signal.SIGINT, _signal.SIGTERM)}
@@ -334,6 +340,14 @@ def main(argv=None) -> int:
             return cmd_curvatures(args)
         if args.command == "centerline-error":
             return cmd_centerline_error(args)
+        if args.command == "sweep":
+            from .sweep.command import main as sweep
+
+            return sweep(args)
+        if args.command == "render":
+            from .output.render_command import main as render
+
+            return render(args)
         if args.command == "warmup":
             from .warmup import main as warmup
 

@@ -1,6 +1,6 @@
 """fem_reference.simulate(strip, protocol, resolution): the FEM run with the DDG models' outputs.
 
-path.csv has ddg.observables.PATH_COLUMNS, then EXTRA_COLUMNS, then the FEM's own columns
+path.csv has ddg.analysis.observables.PATH_COLUMNS, then EXTRA_COLUMNS, then the FEM's own columns
 (FEM_COLUMNS); summary.json every key of ddg.api.base_summary plus recorded_steps,
 resolved_up_to_dW_over_L and the FEM's timing keys. XDMF fields (P1 interpolations of the
 displacement and rotations per recorded step) go to DIR/fields.xdmf for ParaView.
@@ -15,8 +15,8 @@ import numpy as np
 
 from ddg.geometry.strip import InputError, LoadingProtocol, Strip
 from ddg.api import SimulationResult
-from ddg.io import write_centerline_csv, write_path_csv, write_summary_json
-from ddg.observables import resolved_up_to
+from ddg.output.io import write_centerline_csv, write_path_csv, write_summary_json
+from ddg.analysis.observables import resolved_up_to
 
 FEM_COLUMNS = ("negative_eigenvalues", "half_turn_defect_over_L", "point_reflection_defect_over_L", "wall_time_s",
                "xdmf_time")
@@ -128,7 +128,7 @@ def check_inputs(strip, protocol, resolution, across=None, material: str = "isot
     protocol.resolved_shear_ratio(strip)
     directory = None
     if out is not None:
-        from ddg.io import check_output_directory
+        from ddg.output.io import check_output_directory
 
         directory = check_output_directory(out, names["out"])
     return spec, directory
@@ -143,8 +143,8 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
     plate's continuum limit, fem_reference.shell.ShellParameters).
 
     Every input is checked before any work (one-line InputError; mesh bounds and memory:
-    fem_reference.mesh.checked_spec; `out` writable: ddg.io.check_output_directory). Returns the
-    rows (path.csv) and summary; with `out` the run's folder is a ddg.io.RunFolder: from the
+    fem_reference.mesh.checked_spec; `out` writable: ddg.output.io.check_output_directory). Returns the
+    rows (path.csv) and summary; with `out` the run's folder is a ddg.output.io.RunFolder: from the
     start summary.json says status "running", path.csv grows by one row per recorded step
     (SIGKILL loses at most the step being computed), and at the end every file is rewritten
     atomically with status "complete", "stopped" (did not converge; converged = False, the
@@ -153,8 +153,8 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
     `exc.result` (None when interrupted before the first step)."""
     import signal
 
-    from ddg.interrupts import deferred_signals, signal_name_of
-    from ddg.io import STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED, RunFolder
+    from ddg.output.interrupts import deferred_signals, signal_name_of
+    from ddg.output.io import STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED, RunFolder
 
     from .mesh import keep_python_sigint
 

@@ -165,7 +165,7 @@ def _interrupt_behind(exc: BaseException) -> BaseException | None:
 
 def _interrupted(exc: BaseException, args) -> int:
     """One line for a run stopped by SIGINT/SIGTERM; the exit code 128 + the signal number."""
-    from ddg.interrupts import exit_code_of, signal_name_of
+    from ddg.output.interrupts import exit_code_of, signal_name_of
 
     message = getattr(exc, "run_message", None)
     if message is None:
@@ -185,7 +185,7 @@ def _interrupted(exc: BaseException, args) -> int:
 
 def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
-    from ddg.interrupts import terminate_as_interrupt
+    from ddg.output.interrupts import terminate_as_interrupt
 
     terminate_as_interrupt()  # SIGTERM raises an interrupt too: every converged step is written
     args = None

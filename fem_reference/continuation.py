@@ -36,7 +36,7 @@ from .shell import NaghdiStrip
 from .solver import NewtonFailure, Solver
 
 #: Largest deviation from a symmetry (units of L) for a shape to count as having it (the DDG
-#: models use the same, ddg.observables.SYMMETRY_TOLERANCE).
+#: models use the same, ddg.analysis.observables.SYMMETRY_TOLERANCE).
 SYMMETRY_TOLERANCE = 1e-4
 DW1_TOLERANCE = 1e-4
 DW2_TOLERANCE = 1e-3
@@ -178,7 +178,7 @@ class Stepper:
 
 # --- observation ------------------------------------------------------------------------------
 def phase_of(model: NaghdiStrip, positions: np.ndarray) -> tuple[str, float, float]:
-    """U, US+, US-, S+, S- (or '' for the flat strip) by the rule of ddg.observables.phase_label:
+    """U, US+, US-, S+, S- (or '' for the flat strip) by the rule of ddg.analysis.observables.phase_label:
     U if invariant under the half turn about the vertical axis through c, S if invariant under
     the point reflection through c, US otherwise (to SYMMETRY_TOLERANCE L); + when the highest
     point of the centerline (material line y = 0) lies in its first half (x < L/2)."""

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ddg.io import atomic_write_text
+from ddg.output.io import atomic_write_text
 
 
 def observed_order(f1, f2, f3, ratio):
@@ -79,7 +79,7 @@ def check_resolutions(resolutions, width_ratio: float, name: str = "--resolution
 
 
 def run_convergence(args) -> int:
-    from ddg.io import check_output_directory
+    from ddg.output.io import check_output_directory
 
     from .api import check_inputs, simulate
     from .cli import _scene
@@ -107,7 +107,7 @@ def load_runs(folders, name: str = "--runs") -> list:
     import json
 
     from ddg.geometry.strip import InputError
-    from ddg.io import STATUS_RUNNING, StoredRun
+    from ddg.output.io import STATUS_RUNNING, StoredRun
 
     folders = list(folders)
     if len(folders) < MIN_MESHES:
@@ -152,7 +152,7 @@ def load_runs(folders, name: str = "--runs") -> list:
 def table_from_runs(args) -> int:
     """`convergence-table --runs DIR ...`: the convergence table of finished runs of one scene."""
     from ddg.geometry.strip import InputError, LoadingProtocol, Strip
-    from ddg.io import check_output_directory
+    from ddg.output.io import check_output_directory
 
     loaded = load_runs(args.runs)
     scenes = {key for key, _, _ in loaded}

@@ -13,7 +13,7 @@ import json
 import time
 from pathlib import Path
 
-from ddg.io import atomic_write_text
+from ddg.output.io import atomic_write_text
 
 WIDTH_RATIOS = (1 / 20, 1 / 12, 1 / 6, 1 / 3, 1 / 2)
 COMPRESSION_RATIOS = (1 / 2, 1 / 4)
@@ -49,7 +49,7 @@ def check_gold_inputs(args) -> list[tuple[str, float, float, int]]:
     --only names known, --resolution within the mesh bounds and memory (mesh.checked_spec) for
     every selected scene, --out writable. One-line InputError otherwise."""
     from ddg.geometry.strip import InputError
-    from ddg.io import check_output_directory
+    from ddg.output.io import check_output_directory
 
     from .mesh import checked_spec
 
@@ -95,7 +95,7 @@ def run_gold(args) -> int:
             status = status or (0 if result.converged else 3)
             write_index(out)
     finally:  # also after Ctrl-C: the index lists the interrupted scene as not complete
-        from ddg.interrupts import deferred_signals
+        from ddg.output.interrupts import deferred_signals
 
         with deferred_signals():
             write_index(out)

@@ -153,7 +153,7 @@ def test_past_the_pitchfork_the_path_slides_onto_us_along_the_critical_mode():
     Newton slid for 225 (rod, M = 100) to 345 (M = 40). The state is an equilibrium of the free problem."""
     import ddg
     from ddg.api import make_model
-    from ddg.observables import phase_label
+    from ddg.solve.state import phase_label
     from ddg.solve.continuation import ContinuationOptions, PathFollower
     from ddg.solve.newton import scaled_residual
 

@@ -7,7 +7,7 @@ import ddg
 import ddg.solve.dynamics as dynamics
 from ddg.api import SimulationResult
 from ddg.models.rod import RodModel
-from ddg.observables import observe
+from ddg.analysis.observables import observe
 from ddg.solve.dynamics import DynamicOptions, ImplicitEuler, IncrementalPotential, simulate_dynamic
 from ddg.solve.newton import scaled_residual
 

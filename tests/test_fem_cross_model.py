@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ddg.io import read_path_csv
+from ddg.output.io import read_path_csv
 
 GOLD = Path(__file__).resolve().parents[1] / "data" / "fem_gold" / "dL0.5_W0.1667"
 #: dW closer than this to a threshold (of either model) is excluded from the H_mid comparison:

@@ -28,7 +28,7 @@ GIB = 2.0**30
 
 @pytest.fixture(autouse=True)
 def _signal_handlers():
-    """main() installs SIGINT/SIGTERM handlers (ddg.interrupts.terminate_as_interrupt): restore them."""
+    """main() installs SIGINT/SIGTERM handlers (ddg.output.interrupts.terminate_as_interrupt): restore them."""
     saved = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
     yield
     for sig, handler in saved.items():
@@ -158,7 +158,7 @@ def test_argparse_errors_are_one_line(no_fem, capsys, argv, fragment):
     assert "usage" not in err
 
 
-# --- output directory (ddg.io.check_output_directory), every command ---------------------------------------
+# --- output directory (ddg.output.io.check_output_directory), every command ---------------------------------------
 def _bad_out(kind: str, tmp_path: Path) -> str:
     file = tmp_path / "a_file"
     file.write_text("x")
@@ -380,9 +380,9 @@ def test_ctrl_c_keeps_every_converged_step(fem, monkeypatch, capsys, tmp_path):
 
 
 def test_sigterm_during_threshold_location(fem, monkeypatch, capsys, tmp_path):
-    """SIGTERM (as ddg.interrupts raises it) while dW1 is bisected: every recorded step is written,
+    """SIGTERM (as ddg.output.interrupts raises it) while dW1 is bisected: every recorded step is written,
     including the unstable-U row the bisection started from; no threshold reported; exit 143."""
-    from ddg.interrupts import RunInterrupted
+    from ddg.output.interrupts import RunInterrupted
 
     def locate_dw1(*args, **kwargs):
         raise RunInterrupted("SIGTERM")

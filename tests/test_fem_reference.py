@@ -10,10 +10,10 @@ import pytest
 pytest.importorskip("dolfinx", reason="fem_reference needs dolfinx (Debian python3-dolfinx, scripts/setup.sh)")
 pytest.importorskip("slepc4py", reason="fem_reference needs slepc4py (Debian python3-slepc4py, scripts/setup.sh)")
 
-from ddg.analytic import clamped_elastica_midpoint_height  # noqa: E402
+from ddg.analysis.analytic import clamped_elastica_midpoint_height  # noqa: E402
 from ddg.geometry.strip import LoadingProtocol, Strip  # noqa: E402
-from ddg.io import read_path_csv  # noqa: E402
-from ddg.observables import EXTRA_COLUMNS, PATH_COLUMNS  # noqa: E402
+from ddg.output.io import read_path_csv  # noqa: E402
+from ddg.analysis.observables import EXTRA_COLUMNS, PATH_COLUMNS  # noqa: E402
 
 #: Elements along L of the fast tests (10 across W = L/6, 6585 unknowns); the elastica test uses
 #: ELASTICA (36 x 10): H_mid/L error at dL/L = 1/2 is -0.54 % at 24 x 10 and -0.03 % at 60 x 10.

@@ -16,7 +16,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from ddg.frames_output import FrameWriter, polyline_cells, read_frame
+from ddg.output.frames import FrameWriter, polyline_cells, read_frame
 from ddg.geometry.mesh_io import gmsh_mesh, read_mesh
 from ddg.geometry.plate_mesh import structured_mesh
 from ddg.geometry.strip import InputError

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import ddg
-from ddg.analytic import EULER_ANTISYMMETRIC, EULER_SYMMETRIC, clamped_elastica_midpoint_height
+from ddg.analysis.analytic import EULER_ANTISYMMETRIC, EULER_SYMMETRIC, clamped_elastica_midpoint_height
 from ddg.models.plate import PlateModel
 from ddg.solve.stability import lowest_modes
 
@@ -161,7 +161,7 @@ def test_resolution_indicators_of_the_compressed_plate():
 
 
 def test_resolved_up_to_stops_at_the_first_unresolved_shear_row():
-    from ddg.observables import RESOLVED_TURN_ANGLE_DEG, resolved_up_to
+    from ddg.analysis.observables import RESOLVED_TURN_ANGLE_DEG, resolved_up_to
 
     rows = [{"stage": "compression", "dW_over_L": 0.0, "max_turn_angle_deg": 50.0}]
     rows += [{"stage": "shear", "dW_over_L": 0.1 * k, "max_turn_angle_deg": a}

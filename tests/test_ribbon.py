@@ -14,9 +14,10 @@ import pytest
 
 import ddg
 from ddg.cli import main
-from ddg.io import read_path_csv
+from ddg.output.io import read_path_csv
 from ddg.models.ribbon import DEFAULT_ZETA_OVER_L, RibbonModel
-from ddg.ribbon_runs import pitchfork_analysis, run_ribbon
+from ddg.analysis.pitchfork import pitchfork_analysis
+from ddg.ribbon_runs import run_ribbon
 
 STRIP = ddg.Strip.from_ratios(0.05, 0.5)
 L = STRIP.length

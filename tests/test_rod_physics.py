@@ -5,7 +5,7 @@ import pytest
 from scipy.optimize import brentq
 
 import ddg
-from ddg.analytic import (EULER_ANTISYMMETRIC, EULER_SYMMETRIC, clamped_elastica_force,
+from ddg.analysis.analytic import (EULER_ANTISYMMETRIC, EULER_SYMMETRIC, clamped_elastica_force,
                           clamped_elastica_midpoint_height)
 from ddg.models.rod import RodModel
 from ddg.solve.stability import lowest_modes

@@ -1,6 +1,6 @@
 """The lateral clamp force F_shear_norm = F_y L / (E b^3) checked independently of its computation.
 
-ddg.observables.observe reports F = model.clamp_force(gradient): dE/d(clamp translation), the force
+ddg.analysis.observables.observe reports F = model.clamp_force(gradient): dE/d(clamp translation), the force
 the moving clamp applies to the strip (positive along the clamp's motion when the energy grows with
 it). By virtual work, along a path of equilibria F_y = dE/dW, W the clamp's lateral displacement
 (signed: dW_over_L < 0 for shear_sign = -1). Between two recorded states on one branch,
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 import ddg
-from ddg.io import StoredRun
+from ddg.output.io import StoredRun
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 GOLD = DATA / "fem_gold" / "dL0.5_W0.1667"

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddg.analytic import clamped_elastica_midpoint_height
+from ddg.analysis.analytic import clamped_elastica_midpoint_height
 
 from .reference import curve_error, paper_value
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ddg.io import StoredRun
+from ddg.output.io import StoredRun
 
 ROOT = Path(__file__).resolve().parent.parent
 FEM_GOLD = ROOT / "data" / "fem_gold"

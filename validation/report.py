@@ -17,9 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ddg.analytic import clamped_elastica_midpoint_height
+from ddg.analysis.analytic import clamped_elastica_midpoint_height
 from ddg.geometry.strip import shear_limit
-from ddg.io import atomic_write_text
+from ddg.output.io import atomic_write_text
 
 from . import claims as C
 from .reference import PAPER_DROPS_QUARTER, load_gold, paper_value

@@ -19,7 +19,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ddg.io import atomic_write_text, read_numeric_rows
+from ddg.output.io import atomic_write_text, read_numeric_rows
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .continuation import State
+from .state import State
 
 
 class ArclengthFailure(RuntimeError):
@@ -62,11 +62,11 @@ class ArclengthTracer:
         self._residual_tol = max(newton_options.residual_tol, model.residual_floor())
 
     # ------------------------------------------------------------------ geometry of the branch
-    def _inner(self, a_q: np.ndarray, a_w: float, b_q: np.ndarray, b_w: float) -> float:
+    def inner(self, a_q: np.ndarray, a_w: float, b_q: np.ndarray, b_w: float) -> float:
         return float(np.sum(self._weight2 * a_q * b_q)) + a_w * b_w / self._length**2
 
-    def _normalise(self, t_q: np.ndarray, t_w: float) -> tuple[np.ndarray, float]:
-        norm = np.sqrt(self._inner(t_q, t_w, t_q, t_w))
+    def normalise(self, t_q: np.ndarray, t_w: float) -> tuple[np.ndarray, float]:
+        norm = np.sqrt(self.inner(t_q, t_w, t_q, t_w))
         return t_q / norm, t_w / norm
 
     def _shear_rate(self, compression: float) -> np.ndarray:
@@ -82,9 +82,9 @@ class ArclengthTracer:
         H = state.evaluation.hessian
         f_w = model.coupling(H, self._shear_rate(state.compression))
         b = -model.free_matrix(H).solve(f_w)
-        t_q, t_w = self._normalise(b, 1.0)
+        t_q, t_w = self.normalise(b, 1.0)
         if previous is not None:
-            sign = 1.0 if self._inner(t_q, t_w, *previous) >= 0 else -1.0
+            sign = 1.0 if self.inner(t_q, t_w, *previous) >= 0 else -1.0
         else:
             sign = 1.0 if direction >= 0 else -1.0
         return sign * t_q, sign * t_w
@@ -106,7 +106,7 @@ class ArclengthTracer:
                 return None
             r = ev.gradient[free]
             res = float(np.max(np.abs(r / self._residual_scale)))
-            arc = self._inner(q[free] - anchor.q[free], shear - anchor.shear, t_q, t_w) - ds
+            arc = self.inner(q[free] - anchor.q[free], shear - anchor.shear, t_q, t_w) - ds
             K = model.free_matrix(ev.hessian)
             if res < self._residual_tol and abs(arc) < 1e-8 * ds:
                 return State(q, ev, compression, shear, bool(K.cholesky()), iteration)
@@ -117,7 +117,7 @@ class ArclengthTracer:
                 return None
             f_w = model.coupling(ev.hessian, rate)
             a, b = K.solve(np.column_stack([-r, -f_w])).T
-            d_w = (-arc - self._inner(a, 0.0, t_q, t_w)) / (self._inner(b, 0.0, t_q, t_w) + t_w / self._length**2)
+            d_w = (-arc - self.inner(a, 0.0, t_q, t_w)) / (self.inner(b, 0.0, t_q, t_w) + t_w / self._length**2)
             q[free] += a + b * d_w
             shear += d_w
             q[model.constrained] = model.clamp_values(compression, shear)

@@ -23,9 +23,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .arclength import ArclengthOptions, ArclengthTracer
-from .continuation import ContinuationOptions, State
+from .continuation import ContinuationOptions
 from .stability import lowest_modes
-from .thresholds import Snapshot
+from .state import Snapshot, State, crosses, phase_of
 
 
 #: Amplitude (root mean square of the shape change over L) of the first step off the pitchfork.
@@ -36,7 +36,6 @@ PITCHFORK_STEP = 2e-3
 class Branch:
     name: str
     states: list[State] = field(default_factory=list)
-    rows: list[dict] = field(default_factory=list)
     end: str = ""
 
     def folds(self) -> list[float]:
@@ -54,9 +53,6 @@ class BifurcationDiagram:
     branches: list[Branch]
     newton_iterations: int
 
-    def rows(self) -> list[dict]:
-        return [row for branch in self.branches for row in branch.rows]
-
     def summary(self, length: float) -> dict:
         """Per branch: points, dW/L range, folds (dW/L), how it ended; for summary.json."""
         out = {}
@@ -65,44 +61,17 @@ class BifurcationDiagram:
             out[b.name] = {"points": len(b.states),
                            "dW_over_L_range": [min(shear), max(shear)] if shear else None,
                            "folds_dW_over_L": [f / length for f in b.folds()],
-                           "stable_points": int(sum(r["stable"] for r in b.rows)),
+                           "stable_points": int(sum(bool(s.stable) for s in b.states)),
                            "end": b.end}
         return out
-
-
-def _asymmetry(model, state: State) -> float:
-    """Height of the highest point of the first half of the centerline minus that of the second:
-    zero on U and S, of the branch's sign on US+ / US-."""
-    z = model.centerline_positions(state.q, 101)[0][:, 2]
-    return float(np.max(z[:50]) - np.max(z[51:]))
-
-
-def _crosses(measure, seed: State, phase: str, model):
-    """Stop condition: the state has `phase` (U or S: the junction, kept), or `measure` changed
-    sign from the seed's (the tracer went through the junction onto the mirror branch: dropped)."""
-    reference = measure(seed)
-
-    def stop(state: State):
-        if _phase(model, state).rstrip("+-") == phase:
-            return True
-        return "drop" if measure(state) * reference < 0 else False
-
-    return stop
-
-
-def _phase(model, state: State) -> str:
-    from ..observables import phase_label
-
-    return phase_label(model, state.q, state.compression, state.shear)
 
 
 def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, shear_max: float,
                    first_s: Snapshot | None = None,
                    arclength: ArclengthOptions | None = None) -> "BifurcationDiagram":
     """Trace U, US+, US- (and S from first_s, a recorded S state) at the compression of the
-    recorded state `compressed`, for shear between 0 and shear_max (signed)."""
-    from ..observables import observe
-
+    recorded state `compressed`, for shear between 0 and shear_max (signed). The branches carry
+    their equilibria; their rows (branches.csv) are the caller's observation of them."""
     direction = 1.0 if shear_max >= 0 else -1.0
     lo, hi = sorted((0.0, shear_max))
     in_range = (lo - 1e-12, hi + 1e-12)
@@ -111,7 +80,6 @@ def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, sh
 
     def finish(branch: Branch, states: list[State]) -> Branch:
         branch.states = states
-        branch.rows = [{"branch": branch.name, **observe(model, s, "shear", True)} for s in states]
         branches.append(branch)
         return branch
 
@@ -119,7 +87,7 @@ def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, sh
     model.restore_frames(compressed.frames)
     u_states, why = tracer.trace(compressed.state, direction, shear_range=in_range)
     u = finish(Branch("U", end=why), [compressed.state] + u_states)
-    lam = np.array([r["lambda_min"] for r in u.rows])
+    lam = np.array([float(lowest_modes(model, s.evaluation.hessian, 1)[0]) for s in u.states])
     crossing = np.nonzero((lam[:-1] > 0) & (lam[1:] <= 0))[0]
     if crossing.size:
         # branch switching at the pitchfork (Keller): from the U state next to it, the first
@@ -136,11 +104,11 @@ def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, sh
         # by a field with a component along the mode: the symmetry centre moves with the clamp)
         u_q, u_w = tracer.tangent(near, direction=direction)
         phi = mode[model.free]
-        along = tracer._inner(phi, 0.0, u_q, u_w)
+        along = tracer.inner(phi, 0.0, u_q, u_w)
         critical = (phi - along * u_q, -along * u_w)
         for sign, name in ((1.0, "US+"), (-1.0, "US-")):
             model.restore_frames(near.frames)
-            tangent = tracer._normalise(sign * critical[0], sign * critical[1])
+            tangent = tracer.normalise(sign * critical[0], sign * critical[1])
             # the US branches join S at the S branch's own pitchfork, and the tracer would go
             # through the junction onto the mirror branch: stop where H_mid changes sign
             first, _ = tracer.trace(near, tangent=tangent, shear_range=in_range, max_points=1,
@@ -150,7 +118,7 @@ def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, sh
                 continue
             ahead, why = tracer.trace(first[0], tangent=tracer.tangent(first[0], previous=tangent),
                                       shear_range=in_range,
-                                      stop=_crosses(lambda st: model.midpoint(st.q)[2], first[0], "S", model))
+                                      stop=crosses(lambda st: model.midpoint(st.q)[2], first[0], "S", model))
             finish(Branch(name, end=why), first + ahead)
     if first_s is not None:
         state, frames = first_s.state, first_s.frames
@@ -158,5 +126,5 @@ def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, sh
         back, _ = tracer.trace(state, -direction, shear_range=in_range, max_points=80)
         model.restore_frames(frames)
         ahead, why = tracer.trace(state, direction, shear_range=in_range)
-        finish(Branch(_phase(model, state) or "S", end=why), back[::-1] + [state] + ahead)
+        finish(Branch(phase_of(model, state) or "S", end=why), back[::-1] + [state] + ahead)
     return BifurcationDiagram(branches, tracer.newton_iterations)

@@ -16,8 +16,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..geometry.strip import InputError
+from .arclength import ArclengthOptions, ArclengthTracer
 from .newton import ROUNDOFF_STALL_FACTOR, NewtonOptions, check_option, newton
 from .stability import lowest_modes
+from .state import State, asymmetry, crosses, phase_of
 
 
 #: The largest push off an unstable state (relative to L) tried before giving up on it.
@@ -28,12 +30,6 @@ MAX_KICK = 0.05
 #: was then halved), leaving unstable states (branch switching at pitchforks), the compression's
 #: first buckled state, and snaps past folds (pseudo-arclength and energy descent).
 PHASES = ("accepted steps", "rejected steps", "branch switching", "compression start", "fold snaps")
-
-
-def _phase_of(model, state) -> str:
-    from ..observables import phase_label
-
-    return phase_label(model, state.q, state.compression, state.shear)
 
 
 class ContinuationFailure(RuntimeError):
@@ -75,18 +71,6 @@ class ContinuationOptions:
             raise InputError(f"ContinuationOptions(branch_sign={self.branch_sign!r}): must be +1 (US+, S+) or -1 (US-, S-)")
 
 
-@dataclass
-class State:
-    q: np.ndarray
-    evaluation: object
-    compression: float
-    shear: float
-    stable: bool
-    iterations: int = 0
-    branch_switched: bool = False
-    frames: object = None  # the model's reference frames at this state (rod), where kept
-
-
 class PathFollower:
     def __init__(self, model, options: ContinuationOptions | None = None):
         self.model = model
@@ -111,7 +95,7 @@ class PathFollower:
         self.iterations_by_phase[phase] += iterations
 
     # ------------------------------------------------------------------ predictors
-    def _remember(self, state: State, restart: bool = False) -> None:
+    def remember(self, state: State, restart: bool = False) -> None:
         if restart:
             self._history = []
         self._history = (self._history + [(np.array([state.compression, state.shear]), state.q.copy())])[-3:]
@@ -150,7 +134,7 @@ class PathFollower:
         ev = self.model.evaluate(q)
         stable = self.model.free_matrix(ev.hessian).cholesky()
         state = State(q, ev, 0.0, 0.0, stable)
-        self._remember(state, restart=True)
+        self.remember(state, restart=True)
         return state
 
     def start_compression(self, compression: float, direction: int = 1) -> State:
@@ -168,7 +152,7 @@ class PathFollower:
                               result.iterations)
                 state = self._ensure_stable(state, direction)
                 if state is not None:
-                    self._remember(state, restart=True)
+                    self.remember(state, restart=True)
                 return state
             compression *= 0.5
         raise ContinuationFailure(
@@ -220,7 +204,7 @@ class PathFollower:
                 continue
             iterations += new.iterations
             switched = switched or new.branch_switched
-            self._remember(new, restart=new.branch_switched)
+            self.remember(new, restart=new.branch_switched)
             if new.iterations <= self.options.easy_iterations:
                 self._easy_streak += 1
                 if self._easy_streak >= self.options.grow_after:
@@ -284,8 +268,6 @@ class PathFollower:
         """Pseudo-arclength continuation from `state` towards dW = shear. If the branch gets
         there, the equilibrium at `shear` (Newton from the interpolated arclength states); if it
         turns back first (a fold), None, with the fold's dW appended to self.folds."""
-        from .arclength import ArclengthOptions, ArclengthTracer
-
         model = self.model
         saved = model.save_frames()
         direction = 1.0 if shear >= state.shear else -1.0
@@ -326,17 +308,14 @@ class PathFollower:
         branch it meets (U or S, a pitchfork of that branch), then that branch to dW = shear:
         the state the strip snaps to if it is stable there (None otherwise). Energy descent
         (_jump) reaches the same state, but on a plate it slides slowly along the soft valley."""
-        from .arclength import ArclengthTracer
-        from .branches import _asymmetry, _crosses
-
         model = self.model
-        if not _phase_of(model, turned).startswith("US"):
+        if not phase_of(model, turned).startswith("US"):
             return None
         model.restore_frames(turned.frames)
         tracer = ArclengthTracer(model, self.options.newton)
         direction = -1.0 if shear >= turned.shear else 1.0
-        stop_s = _crosses(lambda s: model.midpoint(s.q)[2], turned, "S", model)
-        stop_u = _crosses(lambda s: _asymmetry(model, s), turned, "U", model)
+        stop_s = crosses(lambda s: model.midpoint(s.q)[2], turned, "S", model)
+        stop_u = crosses(lambda s: asymmetry(model, s), turned, "U", model)
 
         def stop(s):
             a, b = stop_s(s), stop_u(s)
@@ -347,14 +326,14 @@ class PathFollower:
         if why != "stop condition" or not points:
             return None
         junction = points[-1]
-        if _phase_of(model, junction).startswith("US"):
+        if phase_of(model, junction).startswith("US"):
             # the tracer stepped through the junction onto the mirror branch: the symmetric state
             # lies between (the two sides are mirror images, so interpolating where the measure
             # vanishes is within O(step^2) of it); converge it at its dW on the symmetric branch
             after = tracer.dropped
             if after is None:
                 return None
-            measure = (lambda s: model.midpoint(s.q)[2]) if stop_s(after) == "drop" else (lambda s: _asymmetry(model, s))
+            measure = (lambda s: model.midpoint(s.q)[2]) if stop_s(after) == "drop" else (lambda s: asymmetry(model, s))
             ma, mb = measure(junction), measure(after)
             weight = ma / (ma - mb)
             q = (1 - weight) * junction.q + weight * after.q
@@ -363,12 +342,12 @@ class PathFollower:
             q[model.constrained] = model.clamp_values(compression, between)
             result = newton(model, q, self.options.newton)
             self._spent(result.iterations, "fold snaps")
-            if not result.converged or _phase_of(model, State(result.q, None, compression, between, False)).startswith("US"):
+            if not result.converged or phase_of(model, State(result.q, None, compression, between, False)).startswith("US"):
                 return None
             model.commit(result.q, result.evaluation)
             junction = State(result.q, result.evaluation, compression, between, bool(result.positive_definite))
         follower = PathFollower(model, replace(self.options, branch_switching=False))
-        follower._remember(junction, restart=True)
+        follower.remember(junction, restart=True)
         try:
             new = follower.advance(junction, compression, shear)
         except ContinuationFailure:
@@ -554,3 +533,17 @@ class PathFollower:
                 hi, side = point, -1
         model.restore_frames(saved)
         return None
+
+
+def relax_from(model, source_model, source_state: State, options: ContinuationOptions) -> State:
+    """Energy descent under `model` from a converged state of `source_model` (same DOF layout),
+    with the source's reference frames; a stable equilibrium of `model` or ContinuationFailure."""
+    model.restore_frames(source_model.save_frames())
+    result = newton(model, source_state.q, options.newton, minimize=True)
+    if not result.converged:
+        L = model.strip.length
+        raise ContinuationFailure(f"the ribbon did not relax from the rod state at dL/L = {source_state.compression / L:.6g}, "
+                                  f"dW/L = {source_state.shear / L:.6g} ({result.message or 'Newton did not converge'})")
+    model.commit(result.q, result.evaluation)
+    return State(result.q, result.evaluation, source_state.compression, source_state.shear,
+                 bool(result.positive_definite), result.iterations)

@@ -30,9 +30,10 @@ import numpy as np
 
 from ..api import SimulationResult, base_summary, conclude_run, finish_summary, open_run_folder
 from ..geometry.strip import InputError, LoadingProtocol, Strip
-from ..observables import observe
+from ..analysis.observables import observe
 from .banded import SymmetricBanded
-from .continuation import ContinuationFailure, ContinuationOptions, PathFollower, State
+from .continuation import ContinuationFailure, ContinuationOptions, PathFollower
+from .state import State
 from .newton import NewtonOptions, newton, scaled_residual
 
 
@@ -286,7 +287,7 @@ def simulate_dynamic(
 
     Stage 1 moves the clamp at s = L along -x at options.clamp_speed until dL = protocol
     .compression_ratio L; stage 2 moves it along y (sign protocol.shear_sign) until
-    dW = protocol.resolved_shear_ratio(strip) L. Rows (the columns of ddg.observables.observe)
+    dW = protocol.resolved_shear_ratio(strip) L. Rows (the columns of ddg.analysis.observables.observe)
     are recorded at the static solver's loads, which the time steps hit exactly; the summary
     has the static summary's keys plus "solver": "implicit-euler", the options under
     scene["dynamics"]. On a Newton failure the step is halved up to options.max_halvings times;

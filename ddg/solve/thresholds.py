@@ -15,23 +15,13 @@ uses its own PathFollower, so the recorded path is not disturbed.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
-from .continuation import ContinuationFailure, PathFollower, State
+from .continuation import ContinuationFailure, PathFollower
 from .stability import lowest_modes
-
-
-@dataclass
-class Snapshot:
-    """A recorded equilibrium with the model's frame state, to restart continuation from."""
-    state: State
-    frames: object
-
-    @classmethod
-    def take(cls, model, state: State) -> "Snapshot":
-        return cls(state, model.save_frames())
+from .state import Snapshot, State, phase_of
 
 
 def _follower(model, options, switching: bool) -> PathFollower:
@@ -41,7 +31,7 @@ def _follower(model, options, switching: bool) -> PathFollower:
 def _advance(model, options, snapshot: Snapshot, shear: float, switching: bool, spent: list | None = None) -> State | None:
     model.restore_frames(snapshot.frames)
     follower = _follower(model, options, switching)
-    follower._remember(snapshot.state, restart=True)
+    follower.remember(snapshot.state, restart=True)
     try:
         return follower.advance(snapshot.state, snapshot.state.compression, shear)
     except ContinuationFailure:
@@ -148,7 +138,6 @@ def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | 
                      tolerances: tuple[float, float] = (1e-4, 1e-3)) -> dict:
     """dW1, dW2 and dW2_S_stable (in metres; None where not bracketed by the recorded path), and
     "newton_iterations": those spent locating them."""
-    from ..observables import phase_label
 
     L = model.strip.length
     saved = model.save_frames()
@@ -159,7 +148,7 @@ def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | 
             out["dW1"] = locate_sign_change(model, options, last_u, first_us, tolerances[0] * L, spent)
         if last_us is not None and first_s is not None:
             def in_s(state):
-                return phase_label(model, state.q, state.compression, state.shear).startswith("S")
+                return phase_of(model, state).startswith("S")
 
             out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L,
                                                spent)

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .geometry.strip import InputError
-from .observables import EXTRA_COLUMNS, PATH_COLUMNS
+from ..geometry.strip import InputError
+from ..analysis.observables import EXTRA_COLUMNS, PATH_COLUMNS
 
 
 def atomic_write_text(path: Path, text: str) -> None:

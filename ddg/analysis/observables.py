@@ -8,9 +8,8 @@ lambda_min: lowest normalised eigenvalue of the free-DOF Hessian (see the model)
 from __future__ import annotations
 
 
-import numpy as np
-
-from .solve.stability import lowest_modes
+from ..solve.stability import lowest_modes
+from ..solve.state import phase_label
 
 PATH_COLUMNS = ("stage", "dL_over_L", "dW_over_L", "H_mid_over_L", "F_shear_norm", "energy", "lambda_min", "phase")
 EXTRA_COLUMNS = ("F_axial_norm", "stable", "newton_iterations", "branch_switched", "max_turn_angle_deg",
@@ -20,51 +19,6 @@ EXTRA_COLUMNS = ("F_axial_norm", "stable", "newton_iterations", "branch_switched
 #: discretisation no longer resolves the shape (e.g. the conical singularities that form at the
 #: clamps near dW_max); summary.json reports the last dW/L recorded below it.
 RESOLVED_TURN_ANGLE_DEG = 30.0
-
-
-#: Largest deviation from a symmetry, relative to L, for a shape to count as having it. The
-#: solver's equilibria are symmetric to ~1e-9 L; just past the pitchfork the asymmetric part of
-#: US grows as sqrt(dW - dW1), above this within 1e-6 L of dW1 (the thresholds themselves come
-#: from stability, ddg.solve.thresholds, not from these labels).
-SYMMETRY_TOLERANCE = 1e-4
-
-
-def symmetry_defects(model, q: np.ndarray, compression: float, shear: float) -> tuple[float, float]:
-    """Deviations (relative to L) of the deformed strip from the two symmetries of the scene.
-
-    With c the midpoint between the clamp points, the material point (s, w) is paired with
-    (L - s, -w) (model.symmetry_partners). U is invariant under the half turn about the vertical
-    axis through c (r -> R_z(pi) (r - c) + c: mirror symmetry of the U about its mid-plane); S
-    under the point reflection through c (r -> 2 c - r, which puts the midpoint at H = 0); US
-    under neither (section 4 of the paper).
-    """
-    L = model.strip.length
-    x = model.positions(q)
-    nodes, partners = model.symmetry_partners()
-    c = np.array([0.5 * (L - compression), 0.5 * shear, 0.0])
-    a, b = x[nodes], x[partners]
-    half_turn = np.stack([2 * c[0] - b[:, 0], 2 * c[1] - b[:, 1], b[:, 2]], axis=1)
-    point = 2 * c - b
-    return (float(np.max(np.linalg.norm(a - half_turn, axis=1))) / L,
-            float(np.max(np.linalg.norm(a - point, axis=1))) / L)
-
-
-def phase_label(model, q: np.ndarray, compression: float, shear: float) -> str:
-    """U, US+, US-, S+ or S- from the symmetries of the shape; '' before buckling (flat strip).
-
-    The sign says which side rises: + when the highest point of the centerline lies in its first
-    half (s < L/2). (Comparing fixed stations such as s = L/4 and 3L/4 fails on S near dW_max,
-    where the lobes move towards the clamps.)"""
-    L = model.strip.length
-    mirror, point = symmetry_defects(model, q, compression, shear)
-    z = model.centerline_positions(q, 101)[0][:, 2]
-    rise = float(np.max(z[:50]) - np.max(z[51:]))
-    if compression == 0.0 and abs(float(model.midpoint(q)[2])) < SYMMETRY_TOLERANCE * L:
-        return ""
-    if mirror < SYMMETRY_TOLERANCE:
-        return "U"
-    sign = "+" if rise >= 0.0 else "-"
-    return ("S" if point < SYMMETRY_TOLERANCE else "US") + sign
 
 
 def observe(model, state, stage: str, eigenvalues: bool = True) -> dict:
@@ -95,7 +49,7 @@ def negative_eigenvalues(model, hessian) -> int | None:
     """The number of unstable directions of an equilibrium: negative eigenvalues of the free-DOF
     Hessian, 0 where its Cholesky succeeds, else the negative pivots of its LDL^T (Sylvester's law
     of inertia; ddg.solve.band_ldlt). None where a pivot is zero to rounding (a critical point)."""
-    from .solve.band_ldlt import UnreliablePivot
+    from ..solve.band_ldlt import UnreliablePivot
 
     try:
         return int(model.free_matrix(hessian).inertia()[0])

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .geometry.strip import InputError
+from ..geometry.strip import InputError
 from .io import atomic_write_text
 
 #: Nodes per cell of the supported cell types.

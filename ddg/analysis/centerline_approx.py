@@ -3,7 +3,7 @@
 Centerline approximation, Eq. (12): the plate node at rest coordinates (s_k, w) is placed at
 x^c = x^p_k + w (m2^k + m2^{k-1}) / 2, with x^p_k the deformed point (s_k, 0) of the plate's
 material line w = 0 and m2 = t x m1 of the edges on either side (m1: the plate's surface normal,
-ddg.curvatures.plate_centerline_frame). Its error field is delta(s, w) = |x^c - x^p| / L, Eq. (13),
+ddg.analysis.curvatures.plate_centerline_frame). Its error field is delta(s, w) = |x^c - x^p| / L, Eq. (13),
 and the mean error the average of delta over all plate nodes (Fig. 10).
 
 w is measured along m2 at rest: with m1 = +z and t = +x, m2 = t x m1 = -y, so w = -y in the
@@ -21,8 +21,8 @@ from __future__ import annotations
 import numpy as np
 
 from .curvatures import _plate_points, framed_curve_curvatures, plate_centerline_frame
-from .geometry.frames import cross, unit
-from .geometry.strip import InputError, Strip
+from ..geometry.frames import cross, unit
+from ..geometry.strip import InputError, Strip
 
 PAPER_WIDTH_RATIOS = (1 / 2, 1 / 3, 1 / 6, 1 / 12, 1 / 20)  # L/W in {2, 3, 6, 12, 20}
 PAPER_SHEAR_RATIOS = (0.1, 0.3, 0.5)
@@ -106,7 +106,7 @@ def centerline_error_study(width_ratios=PAPER_WIDTH_RATIOS, shear_ratios=PAPER_S
     along its stable path (branch switching on). A run that stops converging records NaN for the
     shears it did not reach, with the message."""
     from .curvatures import states_at_shears
-    from .solve.continuation import ContinuationFailure
+    from ..solve.continuation import ContinuationFailure
 
     rows = []
     for ratio in width_ratios:
@@ -119,7 +119,7 @@ def centerline_error_study(width_ratios=PAPER_WIDTH_RATIOS, shear_ratios=PAPER_S
         try:
             for model, state in states_at_shears("plate", strip, compression_ratio, wanted, triangles,
                                                  max_step=max_step, options=options):
-                from .observables import phase_label
+                from ..solve.state import phase_label
 
                 field = centerline_error_field(model, state.q)
                 edges = edge_reconstruction(model, state.q)

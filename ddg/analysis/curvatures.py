@@ -19,11 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .energies.hinge_bending import triangle_normals
-from .energies.rod_curvature import material_curvatures
-from .geometry.frames import cross, reference_twist, rowdot, unit
-from .geometry.strip import InputError
-from .io import atomic_write_text
+from ..energies.hinge_bending import triangle_normals
+from ..energies.rod_curvature import material_curvatures
+from ..geometry.frames import cross, reference_twist, rowdot, unit
+from ..geometry.strip import InputError
+from ..output.io import atomic_write_text
 
 CURVATURE_COLUMNS = ("model", "step", "dL_over_L", "dW_over_L", "s_over_L", "k1_L", "k2_L", "tau_L")
 
@@ -157,9 +157,9 @@ def states_at_shears(model_name: str, strip, compression_ratio: float, shear_rat
     of at most max_step L, quasi-static), yielding (model, state) at each requested dW/L.
 
     model_name: rod, plate, ribbon; for the ribbon ribbon_init="rod" follows the rod and relaxes
-    each requested state under the ribbon energy (ddg.ribbon_runs)."""
-    from .api import make_model
-    from .solve.continuation import ContinuationOptions, PathFollower
+    each requested state under the ribbon energy (ddg.solve.continuation.relax_from)."""
+    from ..api import make_model
+    from ..solve.continuation import ContinuationOptions, PathFollower
 
     shear_ratios = sorted(float(r) for r in np.atleast_1d(shear_ratios))
     if not shear_ratios or shear_ratios[0] < 0:
@@ -171,9 +171,10 @@ def states_at_shears(model_name: str, strip, compression_ratio: float, shear_rat
     L = strip.length
     relax = None
     if model_name == "ribbon":
-        from .models.ribbon import RibbonModel
-        from .models.rod import RodModel
-        from .ribbon_runs import RIBBON_INITS, relax_from
+        from ..models.ribbon import RibbonModel
+        from ..models.rod import RodModel
+        from ..models.ribbon import RIBBON_INITS
+        from ..solve.continuation import relax_from
 
         if ribbon_init not in RIBBON_INITS:
             raise InputError(f"ribbon init = {ribbon_init!r} is not available; choose one of {list(RIBBON_INITS)}")
@@ -212,7 +213,7 @@ def inflection_twist_study(width_ratios=(1 / 20, 1 / 6), slendernesses=(300.0, 6
     centerline, their ratio, and the k2 and tau jump ratios (inflection_jumps). As the plate
     thins, stretching costs more against bending and the surface becomes developable, which
     forces the twist at the inflection towards zero (Sadowsky's limit, Figs. A.13-A.14)."""
-    from .geometry.strip import Strip
+    from ..geometry.strip import Strip
 
     rows = []
     for ratio in width_ratios:

@@ -2,7 +2,11 @@
 
 path.csv has ddg.analysis.observables.PATH_COLUMNS, then EXTRA_COLUMNS, then the FEM's own columns
 (FEM_COLUMNS); summary.json every key of ddg.api.base_summary plus recorded_steps,
-resolved_up_to_dW_over_L and the FEM's timing keys. XDMF fields (P1 interpolations of the
+resolved_up_to_dW_over_L, the FEM's timing keys and its iteration and time breakdowns
+(newton_iterations_by_phase: fem_reference.solver.ITERATION_PHASES, summing to newton_iterations,
+then counts of failed solves, step halvings and snaps; wall_time_by_phase_s:
+fem_reference.solver.TIME_PHASES, summing to wall_time_s; wall_time_within_phases_s: the split of
+threshold location and branch switching into the same sections). XDMF fields (P1 interpolations of the
 displacement and rotations per recorded step) go to DIR/fields.xdmf for ParaView.
 """
 from __future__ import annotations
@@ -213,9 +217,10 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
         rows.append(obs.row)
         centerlines.append(observer.centerline(CENTERLINE_STATIONS))
         if xdmf is not None:  # time stamps count frames (a replaced row keeps its frame)
-            model.update_output_fields()
-            xdmf.write_function(model.u1, float(frames[0]))
-            xdmf.write_function(model.theta1, float(frames[0]))
+            with clock.section("I/O"):
+                model.update_output_fields()
+                xdmf.write_function(model.u1, float(frames[0]))
+                xdmf.write_function(model.theta1, float(frames[0]))
             obs.row["xdmf_time"] = frames[0]
             frames[0] += 1
         if progress:
@@ -229,10 +234,12 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
         """Append the rows recorded since the last call to path.csv (a shear step's row is final
         once its branch switch, which replaces it, is done)."""
         if folder is not None:
-            for row in rows[written[0]:]:
-                folder.append(row)
+            with clock.section("I/O"):
+                for row in rows[written[0]:]:
+                    folder.append(row)
         written[0] = len(rows)
 
+    clock = solver.clock
     t0_path = time.perf_counter()
     switched = False
     last_stable_u = None  # (load, state, history) of the last recorded stable U state
@@ -244,8 +251,9 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
         if directory is not None and fields:
             from dolfinx.io import XDMFFile
 
-            xdmf = XDMFFile(model.mesh.comm, str(directory / "fields.xdmf"), "w")
-            xdmf.write_mesh(model.mesh)
+            with clock.section("I/O"):
+                xdmf = XDMFFile(model.mesh.comm, str(directory / "fields.xdmf"), "w")
+                xdmf.write_mesh(model.mesh)
         stage = "the compression stage"
         t0 = time.perf_counter()
         model.set_clamp(0.0, 0.0)
@@ -259,7 +267,8 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
                 model.set_clamp(guess_at, 0.0)
                 model.inextensible_guess(guess_at)
                 try:
-                    its = solver.newton()
+                    with solver.counting("compression start"):
+                        its = solver.newton()
                 except Exception as exc:
                     raise ContinuationFailure(f"Newton from the inextensible guess at dL/L = {guess_at:g}: {exc}")
                 stepper.branch.reset(stepper.load, model.get_state())
@@ -272,7 +281,8 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
             step_times.append(time.perf_counter() - t0)
         summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
         if folder is not None:
-            folder.checkpoint(summary)
+            with clock.section("I/O"):
+                folder.checkpoint(summary)
         stepper.branch.reset(stepper.load, model.get_state())
         n_shear = protocol.shear_steps if dW_end != 0.0 else 0
         for k in range(1, n_shear + 1):
@@ -292,14 +302,16 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
                     if options.thresholds and dw1_info is None and last_stable_u is not None:
                         stage = "threshold location (dW1, bisection on U)"
                         tt = time.perf_counter()
-                        dw1, it1 = locate_dw1(stepper, last_stable_u, target[1])
+                        with clock.section("threshold location"):
+                            dw1, it1 = locate_dw1(stepper, last_stable_u, target[1])
+                            stepper.restore(here[0], here[1], here[2])
                         dw1_info = {"dW1": dw1, "iterations": it1, "time": time.perf_counter() - tt}
-                        stepper.restore(here[0], here[1], here[2])
                     if options.branch_switching:
                         stage = "the branch switch (U to US)"
                         tt = time.perf_counter()
-                        values, vectors = solver.lowest_modes(1)
-                        it_sw, amp = switch_branch(stepper, vectors[0], options.perturbation)
+                        with clock.section("branch switching"):
+                            values, vectors = solver.lowest_modes(1)
+                            it_sw, amp = switch_branch(stepper, vectors[0], options.perturbation)
                         rows.pop()
                         centerlines.pop()
                         obs = record("shear", its + it_sw, t0, switched=True)
@@ -319,9 +331,10 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
                         Branch(list(stepper.branch.loads), list(stepper.branch.states)))
                 stage = "threshold location (dW2, bisection from US)"
                 tt = time.perf_counter()
-                dw2, it2 = locate_dw2(stepper, last_us, target[1])
+                with clock.section("threshold location"):
+                    dw2, it2 = locate_dw2(stepper, last_us, target[1])
+                    stepper.restore(here[0], here[1], here[2])
                 dw2_info = {"dW2": dw2, "iterations": it2, "time": time.perf_counter() - tt}
-                stepper.restore(here[0], here[1], here[2])
             commit()
             step_times.append(time.perf_counter() - t0)
         stage = "the end of the run"
@@ -338,15 +351,23 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
     try:
         with deferred_signals():  # a second Ctrl-C cannot cut the result files
             if xdmf is not None:
-                xdmf.close()
+                with clock.section("I/O"):
+                    xdmf.close()
             if dw1_info:
                 summary["dW1_over_L"] = abs(dw1_info["dW1"])
             if dw2_info:
                 summary["dW2_over_L"] = abs(dw2_info["dW2"])
             summary["threshold_wall_time_s"] = sum(d["time"] for d in (dw1_info, dw2_info) if d)
             summary["newton_iterations"] = solver.total_iterations
-            summary["wall_time_s"] = time.perf_counter() - t0_path + summary["build_wall_time_s"]
-            summary["path_wall_time_s"] = time.perf_counter() - t0_path
+            path_wall = time.perf_counter() - t0_path
+            summary["wall_time_s"] = path_wall + summary["build_wall_time_s"]
+            summary["path_wall_time_s"] = path_wall
+            breakdown = stepper.iteration_breakdown()
+            summary["newton_iterations_by_phase"] = breakdown
+            if options.thresholds:
+                summary["threshold_newton_iterations"] = breakdown["threshold dW1"] + breakdown["threshold dW2"]
+            summary["wall_time_by_phase_s"] = clock.breakdown(path_wall, {"build": summary["build_wall_time_s"]})
+            summary["wall_time_within_phases_s"] = {k: dict(v) for k, v in clock.within.items()}
             summary["wall_time_per_step_s"] = float(np.mean(step_times)) if step_times else None
             summary["recorded_steps"] = len(rows)
             summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)

@@ -24,6 +24,12 @@ branch switching (paper section 4, App. B, E).
   (no half-turn symmetry to 1e-4 L) and has no negative eigenvalue.
 * dW2: once on US, the first recorded step labelled S is bracketed and bisected (solving from
   the last US state) to 1e-3 L: dW2 is the smallest dW found in S.
+
+Counters: every Newton solve counts its iterations in one phase of solver.ITERATION_PHASES
+(Stepper.advance: "accepted steps" / "rejected steps" / "fold snaps", or the threshold phase the
+stepper is in, Stepper.phase; switch_branch: "branch switching"); Stepper.step_halvings and
+Stepper.snaps count the substeps halved and the snaps made; Stepper.iteration_breakdown() is
+summary.json's newton_iterations_by_phase.
 """
 from __future__ import annotations
 
@@ -33,7 +39,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .shell import NaghdiStrip
-from .solver import NewtonFailure, Solver
+from .solver import ITERATION_PHASES, NewtonFailure, Solver  # noqa: F401  (ITERATION_PHASES re-exported)
 
 #: Largest deviation from a symmetry (units of L) for a shape to count as having it (the DDG
 #: models use the same, ddg.analysis.observables.SYMMETRY_TOLERANCE).
@@ -91,6 +97,19 @@ class Stepper:
         self.model, self.solver, self.options = model, solver, options
         self.branch = Branch()
         self.substep = math.inf
+        #: the phase (solver.ITERATION_PHASES) every solve of advance() counts in, converged or
+        #: not; None: the path's own load steps ("accepted steps", "rejected steps", "fold snaps")
+        self.phase: str | None = None
+        self.step_halvings = 0  # substeps halved after failing (all phases)
+        self.snaps = 0  # substeps that converged by energy descent past a fold (all phases)
+
+    def iteration_breakdown(self) -> dict:
+        """summary.json's newton_iterations_by_phase: the solver's Newton iterations per phase
+        (ITERATION_PHASES; they sum to solver.total_iterations), then counts (not iterations):
+        "failed solves" (Newton solves that raised NewtonFailure, every phase), "step halvings"
+        and "snaps" (Stepper.advance, every phase)."""
+        return {**self.solver.iterations_by_phase, "failed solves": self.solver.failed_solves,
+                "step halvings": self.step_halvings, "snaps": self.snaps}
 
     @property
     def load(self) -> np.ndarray:
@@ -123,6 +142,10 @@ class Stepper:
         current = self.load
         if len(self.branch.states) == 0:
             self.branch.reset(current, start_state)
+        if self.phase is None:
+            accepted, rejected, snap = "accepted steps", "rejected steps", "fold snaps"
+        else:
+            accepted = rejected = snap = self.phase
         while np.linalg.norm(target - current) > 1e-14:
             remaining = np.linalg.norm(target - current)
             size = min(self.substep, remaining, self.options.max_substep)
@@ -131,7 +154,8 @@ class Stepper:
             ok = False
             for use_predictor in (True, False):
                 try:
-                    its = self.solve_at(trial, state0, use_predictor)
+                    with self.solver.counting(accepted, rejected):
+                        its = self.solve_at(trial, state0, use_predictor)
                     ok = True
                     break
                 except NewtonFailure:
@@ -142,15 +166,18 @@ class Stepper:
                 self.model.set_state(state0)
                 self.model.set_clamp(*trial)
                 try:
-                    its = self.solver.descend()
+                    with self.solver.counting(snap):
+                        its = self.solver.descend()
                     ok = True
                     stats.snaps += 1
+                    self.snaps += 1
                 except NewtonFailure:
                     stats.rejected += 1
             if not ok:
                 self.model.set_state(state0)
                 self.model.set_clamp(*current)
                 self.substep = size / 2.0
+                self.step_halvings += 1
                 if self.substep < self.options.min_substep:
                     raise ContinuationFailure(
                         f"load step below {self.options.min_substep:g} L without convergence from "
@@ -263,17 +290,21 @@ def locate_dw1(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW1
     load_a, state_a, history_a = low
     a, b = float(load_a[1]), float(high_shear)
     iterations = 0
-    while b - a > tol:
-        mid = 0.5 * (a + b)
-        stepper.restore(load_a, state_a, history_a)
-        stats = stepper.advance((load_a[0], mid))
-        iterations += stats.newton_iterations
-        if stepper.solver.negative_eigenvalues() == 0:
-            a = mid
-            load_a, state_a = np.array(stepper.load), stepper.model.get_state()
-            history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
-        else:
-            b = mid
+    saved_phase, stepper.phase = stepper.phase, "threshold dW1"
+    try:
+        while b - a > tol:
+            mid = 0.5 * (a + b)
+            stepper.restore(load_a, state_a, history_a)
+            stats = stepper.advance((load_a[0], mid))
+            iterations += stats.newton_iterations
+            if stepper.solver.negative_eigenvalues() == 0:
+                a = mid
+                load_a, state_a = np.array(stepper.load), stepper.model.get_state()
+                history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
+            else:
+                b = mid
+    finally:
+        stepper.phase = saved_phase
     return 0.5 * (a + b), iterations
 
 
@@ -287,7 +318,12 @@ def switch_branch(stepper: Stepper, mode: np.ndarray, perturbation: float, growt
     the interpolated state then lands on US+ (a pure perturbation of the U state followed by
     Newton falls back to U: the linear mode stretches the mid-surface at finite amplitude).
     Returns (iterations, amplitude) or raises ContinuationFailure unless the result is US with
-    no negative eigenvalue."""
+    no negative eigenvalue. Its Newton iterations count as "branch switching"."""
+    with stepper.solver.counting("branch switching"):
+        return _switch_branch(stepper, mode, perturbation, growth, max_amplitude, max_increment)
+
+
+def _switch_branch(stepper, mode, perturbation, growth, max_amplitude, max_increment):
     m, solver = stepper.model, stepper.solver
     base = m.get_state()
     load = stepper.load
@@ -370,6 +406,7 @@ def locate_dw2(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW2
     iterations = 0
     saved = stepper.options
     stepper.options = replace(saved, snap_substep=0.0, min_substep=max(saved.min_substep, 1e-2 * tol))
+    saved_phase, stepper.phase = stepper.phase, "threshold dW2"
     try:
         while b - a > tol:
             mid = 0.5 * (a + b)
@@ -389,4 +426,5 @@ def locate_dw2(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW2
                 history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
     finally:
         stepper.options = saved
+        stepper.phase = saved_phase
     return b, iterations

@@ -7,10 +7,18 @@ of D, hence the number of negative eigenvalues of the constrained tangent (Sylve
 on PETSc 3.18.5: the count agrees with SLEPc's eigenvalues (tests/test_fem_reference.py).
 Dirichlet rows and columns are replaced by the identity (diagonal 1), which adds only positive
 eigenvalues, and by 0 on the metric M, which sends them to infinity in K v = lambda M v.
+
+Counters (cheap: integer sums and time.perf_counter differences, read through public attributes):
+Solver.iterations_by_phase (Newton iterations per ITERATION_PHASES, the phase set by
+Solver.counting), Solver.failed_solves, and Solver.clock (a PhaseClock: wall time of assembly,
+factorisations, triangular solves and eigenvalue/inertia work, and of the sections the
+continuation opens: threshold location, branch switching, I/O).
 """
 from __future__ import annotations
 
 import math
+import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -21,6 +29,80 @@ from .shell import NaghdiStrip
 
 
 DEBUG = False
+
+#: Where the Newton iterations of a run go (Solver.iterations_by_phase; summary.json
+#: "newton_iterations_by_phase", with the same names as ddg.solve.continuation.PHASES where the
+#: meaning is the same): solves of load steps that converged ("accepted steps") and that failed
+#: ("rejected steps": the substep was then retried without the secant predictor or halved),
+#: leaving the unstable U state at the pitchfork ("branch switching": the bordered amplitude
+#: continuation and the final Newton), Newton from the inextensible guess at the first compression
+#: step ("compression start"), Levenberg-Marquardt descent past a fold with its closing Newton
+#: ("fold snaps"), the bisections of the thresholds ("threshold dW1" on U, "threshold dW2" from
+#: US: every solve in them, converged or not), and solves made outside any of these ("other": a
+#: caller that set no phase, e.g. a test calling Solver.newton directly). Unlike the DDG models,
+#: the FEM's newton_iterations counts every phase, thresholds included: the entries sum to it.
+ITERATION_PHASES = ("accepted steps", "rejected steps", "branch switching", "compression start", "fold snaps",
+                    "threshold dW1", "threshold dW2", "other")
+
+#: Sections of PhaseClock (summary.json "wall_time_by_phase_s", a partition of the run's wall
+#: time): "build" (mesh, forms, solver set-up), "assembly" (residual and tangent, dolfinx),
+#: "factorisation" (MUMPS L D L^T of the Newton tangent), "linear solves" (its triangular
+#: solves), "eigenvalues and inertia" (the inertia factorisation of the stability test and
+#: SLEPc's shift-invert eigensolve, each with its own MUMPS factorisation), "threshold location"
+#: and "branch switching" (all of their time, whatever it is spent on; the split inside them is
+#: in "wall_time_within_phases_s"), "I/O" (XDMF fields, path.csv rows, summary checkpoints), and
+#: "other" (the rest: observables, centerlines, copies of states, Python bookkeeping).
+TIME_PHASES = ("build", "assembly", "factorisation", "linear solves", "eigenvalues and inertia",
+               "threshold location", "branch switching", "I/O", "other")
+#: Sections that keep all of their time (the sections opened inside them are split separately).
+OPAQUE_SECTIONS = ("threshold location", "branch switching")
+
+
+class PhaseClock:
+    """Wall time per section, exclusive: `with clock.section(name):` adds to seconds[name] the
+    time spent in the block minus the time of the sections opened inside it, so the sections
+    never count a second twice. Inside an opaque section (OPAQUE_SECTIONS) the inner sections
+    add to within[opaque name][inner name] instead, and the opaque section keeps its whole time
+    (its own remainder is within[...]["other"]). Cost: two perf_counter calls per section."""
+
+    def __init__(self, opaque=OPAQUE_SECTIONS):
+        self.opaque = tuple(opaque)
+        self.seconds: dict[str, float] = {}
+        self.within: dict[str, dict[str, float]] = {}
+        self._stack: list[list] = []  # [name, start, seconds of the sections opened inside]
+
+    @contextmanager
+    def section(self, name: str):
+        frame = [name, time.perf_counter(), 0.0]
+        self._stack.append(frame)
+        try:
+            yield
+        finally:
+            total = time.perf_counter() - frame[1]
+            self._stack.pop()
+            if self._stack:
+                self._stack[-1][2] += total
+            owner = next((f[0] for f in reversed(self._stack) if f[0] in self.opaque), None)
+            if name in self.opaque and owner is None:
+                self.seconds[name] = self.seconds.get(name, 0.0) + total
+                inner = self.within.setdefault(name, {})
+                inner["other"] = inner.get("other", 0.0) + total - frame[2]
+            elif owner is None:
+                self.seconds[name] = self.seconds.get(name, 0.0) + total - frame[2]
+            else:
+                inner = self.within.setdefault(owner, {})
+                inner[name] = inner.get(name, 0.0) + total - frame[2]
+
+    def breakdown(self, total: float, outside: dict | None = None, phases=TIME_PHASES) -> dict[str, float]:
+        """Seconds of every phase (0 where none was spent): `outside` (phases timed before the
+        clock ran, e.g. {"build": s}) as given, the clock's sections, and "other" = total (the
+        wall time the clock covered) minus its sections; the values sum to total + outside."""
+        outside = dict(outside or {})
+        measured = {k: v for k, v in self.seconds.items() if k != "other" and k not in outside}
+        out = {name: outside.get(name, measured.get(name, 0.0)) for name in phases if name != "other"}
+        out.update({k: v for k, v in {**outside, **measured}.items() if k not in out})
+        out["other"] = total - sum(measured.values())
+        return out
 
 
 class NewtonFailure(RuntimeError):
@@ -74,29 +156,76 @@ class Solver:
         self.M = fem.petsc.assemble_matrix(model.mass_form, bcs=model.bcs, diagonal=0.0)
         self.M.assemble()
         self.total_iterations = 0
+        #: Newton iterations per phase (ITERATION_PHASES); they sum to total_iterations
+        self.iterations_by_phase: dict[str, int] = dict.fromkeys(ITERATION_PHASES, 0)
+        #: Newton solves (newton, newton_bordered, descend) that raised NewtonFailure
+        self.failed_solves = 0
+        #: iterations of the last solve, converged or not
+        self.last_iterations = 0
+        #: wall time per section (assembly, factorisation, linear solves, eigenvalues and inertia,
+        #: and those the continuation opens)
+        self.clock = PhaseClock()
+        self._phase = ("other", "other")
+
+    # --- counters ----------------------------------------------------------------------
+    @contextmanager
+    def counting(self, phase: str, failed: str | None = None):
+        """Newton iterations of the solves in the block count as `phase` when the solve
+        converges and as `failed` (default: phase) when it raises NewtonFailure."""
+        for name in (phase, failed):
+            if name is not None and name not in self.iterations_by_phase:
+                raise ValueError(f"unknown phase {name!r}; one of {ITERATION_PHASES}")
+        saved = self._phase
+        self._phase = (phase, failed or phase)
+        try:
+            yield
+        finally:
+            self._phase = saved
+
+    def _spent(self, iterations: int, converged: bool) -> None:
+        self.total_iterations += iterations
+        self.last_iterations = iterations
+        self.iterations_by_phase[self._phase[0 if converged else 1]] += iterations
+        if not converged:
+            self.failed_solves += 1
+
+    def _fail(self, iterations: int, message: str) -> NewtonFailure:
+        self._spent(iterations, False)
+        return NewtonFailure(message)
+
+    def _factor_and_solve(self, ksp: PETSc.KSP, rhs: PETSc.Vec, out: PETSc.Vec) -> None:
+        """Factorise ksp's operator if it changed (timed as "factorisation"), then the
+        triangular solves ("linear solves")."""
+        with self.clock.section("factorisation"):
+            ksp.setUp()
+        with self.clock.section("linear solves"):
+            ksp.solve(rhs, out)
 
     # --- assembly ----------------------------------------------------------------------
     def assemble_tangent(self) -> PETSc.Mat:
-        self.A.zeroEntries()
-        fem.petsc.assemble_matrix(self.A, self.model.tangent_form, bcs=self.model.bcs, diagonal=1.0)
-        self.A.assemble()
+        with self.clock.section("assembly"):
+            self.A.zeroEntries()
+            fem.petsc.assemble_matrix(self.A, self.model.tangent_form, bcs=self.model.bcs, diagonal=1.0)
+            self.A.assemble()
         return self.A
 
     def assemble_residual(self) -> PETSc.Vec:
         """R(q) with the lifting of the clamp values: the bc rows hold q - g."""
         m, b, x = self.model, self.b, self.model.q.vector
-        with b.localForm() as loc:
-            loc.set(0.0)
-        fem.petsc.assemble_vector(b, m.residual_form)
-        fem.petsc.apply_lifting(b, [m.tangent_form], bcs=[m.bcs], x0=[x], scale=-1.0)
-        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        fem.petsc.set_bc(b, m.bcs, x, -1.0)
+        with self.clock.section("assembly"):
+            with b.localForm() as loc:
+                loc.set(0.0)
+            fem.petsc.assemble_vector(b, m.residual_form)
+            fem.petsc.apply_lifting(b, [m.tangent_form], bcs=[m.bcs], x0=[x], scale=-1.0)
+            b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            fem.petsc.set_bc(b, m.bcs, x, -1.0)
         return b
 
     # --- Newton --------------------------------------------------------------------------
     def newton(self) -> int:
         """Solve R(q) = 0 from the current q with the current clamp values; returns iterations.
-        Raises NewtonFailure (q is then left at the last iterate)."""
+        Raises NewtonFailure (q is then left at the last iterate). The iterations count in the
+        phase of Solver.counting (its failed phase when NewtonFailure is raised)."""
         opts, m = self.options, self.model
         x = m.q.vector
         r0 = None
@@ -106,37 +235,34 @@ class Solver:
             if DEBUG:
                 print("newton", it, r, self.dx.norm(PETSc.NormType.NORM_INFINITY) if it else 0.0)
             if not np.isfinite(r):
-                raise NewtonFailure(f"residual not finite at iteration {it}")
+                raise self._fail(it, f"residual not finite at iteration {it}")
             if r0 is None:
                 r0 = r
             if r <= max(opts.atol, opts.rtol * r0):
-                self.total_iterations += it
+                self._spent(it, True)
                 return it
             if it > 0 and (r > opts.divergence_factor * max(r0, opts.atol)):
-                self.total_iterations += it
-                raise NewtonFailure(f"residual grew from {r0:.3e} to {r:.3e}")
+                raise self._fail(it, f"residual grew from {r0:.3e} to {r:.3e}")
             if it == opts.max_iterations:
                 break
             self.assemble_tangent()
             self.ksp.setOperators(self.A)
             try:
-                self.ksp.solve(b, self.dx)
+                self._factor_and_solve(self.ksp, b, self.dx)
             except PETSc.Error as exc:  # factorisation failure
-                self.total_iterations += it
-                raise NewtonFailure(f"factorisation failed: {exc}") from None
+                raise self._fail(it, f"factorisation failed: {exc}") from None
             if self.ksp.getConvergedReason() < 0:
-                self.total_iterations += it
-                raise NewtonFailure(f"linear solve failed ({self.ksp.getConvergedReason()})")
+                raise self._fail(it, f"linear solve failed ({self.ksp.getConvergedReason()})")
             x.axpy(-1.0, self.dx)
             x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
             step = self.dx.norm(PETSc.NormType.NORM_INFINITY)
             if not np.isfinite(step):
-                raise NewtonFailure("correction not finite")
+                raise self._fail(it + 1, "correction not finite")
             if step < opts.dx_tol:
-                self.total_iterations += it + 1
+                self._spent(it + 1, True)
                 return it + 1
-        self.total_iterations += opts.max_iterations
-        raise NewtonFailure(f"no convergence in {opts.max_iterations} iterations (|R| = {r:.3e}, |R0| = {r0:.3e})")
+        raise self._fail(opts.max_iterations,
+                         f"no convergence in {opts.max_iterations} iterations (|R| = {r:.3e}, |R0| = {r0:.3e})")
 
     def newton_bordered(self, c: PETSc.Vec, q_ref: np.ndarray, amplitude: float, mu: float = 0.0):
         """Solve R(q) + mu c = 0 with c . (q - q_ref) = amplitude for (q, mu) from the current q:
@@ -150,6 +276,7 @@ class Solver:
         kc = self.b.duplicate()
         diff = self.b.duplicate()
         r0 = None
+        it = 0
         try:
             for it in range(opts.max_iterations + 1):
                 b = self.assemble_residual()
@@ -161,19 +288,23 @@ class Solver:
                 if DEBUG:
                     print("bordered", it, b.norm(), r2, mu, self.dx.norm(PETSc.NormType.NORM_INFINITY) if it else 0.0)
                 if not np.isfinite(r):
-                    raise NewtonFailure("bordered residual not finite")
+                    raise self._fail(it, "bordered residual not finite")
                 r0 = r if r0 is None else r0
                 if r <= max(opts.atol, opts.rtol * r0) and it > 0:
-                    self.total_iterations += it
+                    self._spent(it, True)
                     return it, mu
                 if it == opts.max_iterations:
                     break
                 self.assemble_tangent()
                 self.ksp.setOperators(self.A)
-                self.ksp.solve(b, self.dx)
-                self.ksp.solve(c, kc)
+                try:
+                    self._factor_and_solve(self.ksp, b, self.dx)
+                    with self.clock.section("linear solves"):
+                        self.ksp.solve(c, kc)
+                except PETSc.Error as exc:
+                    raise self._fail(it, f"factorisation failed in the bordered Newton: {exc}") from None
                 if self.ksp.getConvergedReason() < 0:
-                    raise NewtonFailure("linear solve failed in the bordered Newton")
+                    raise self._fail(it, "linear solve failed in the bordered Newton")
                 dmu = (r2 - c.dot(self.dx)) / c.dot(kc)
                 # dq = -(K^-1 r1 + dmu K^-1 c); the lifted residual already holds q - g on bc rows
                 x.axpy(-1.0, self.dx)
@@ -182,27 +313,29 @@ class Solver:
                 mu += dmu
                 self.dx.axpy(dmu, kc)
                 if self.dx.norm(PETSc.NormType.NORM_INFINITY) < opts.dx_tol:
-                    self.total_iterations += it + 1
+                    self._spent(it + 1, True)
                     return it + 1, mu
         finally:
             ref.destroy()
             kc.destroy()
             diff.destroy()
-        self.total_iterations += opts.max_iterations
-        raise NewtonFailure(f"bordered Newton: no convergence in {opts.max_iterations} iterations")
+        raise self._fail(opts.max_iterations, f"bordered Newton: no convergence in {opts.max_iterations} iterations")
 
     def descend(self, max_steps: int = 200, sigma: float = 1e-2) -> int:
         """Snap to a stable equilibrium at the current clamp values: Levenberg-Marquardt steps
         (K + sigma diag K) dq = -R, sigma raised until that matrix has no negative eigenvalue
         (inertia) and the energy falls, lowered after each success; plain Newton is tried once
         sigma is small. Used past a fold, where Newton from the last state cannot converge.
-        Returns iterations; raises NewtonFailure."""
+        Returns iterations (accepted Levenberg-Marquardt steps plus the closing Newton's); raises
+        NewtonFailure. Each iteration counts once in Solver.iterations_by_phase (the closing
+        Newton counts its own; the Levenberg-Marquardt steps are counted here)."""
         m = self.model
         x = m.q.vector
         fem.petsc.set_bc(x, m.bcs)  # impose the clamp values exactly (the load step is tiny)
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         energy = m.energy()
-        its = 0
+        its = 0  # returned: LM steps and the closing Newton's iterations
+        steps = 0  # LM steps not yet counted
         for _ in range(max_steps):
             base = m.get_state()
             b = self.assemble_residual()
@@ -214,11 +347,13 @@ class Solver:
                 shifted.scale(1.0 + sigma)
                 A.setDiagonal(shifted)
                 self.inertia_ksp.setOperators(A)
-                self.inertia_ksp.setUp()
-                nneg, nzero, _ = self.inertia_ksp.getPC().getFactorMatrix().getInertia()
+                with self.clock.section("factorisation"):
+                    self.inertia_ksp.setUp()
+                    nneg, nzero, _ = self.inertia_ksp.getPC().getFactorMatrix().getInertia()
                 ok = nneg + nzero == 0
                 if ok:
-                    self.inertia_ksp.solve(b, self.dx)
+                    with self.clock.section("linear solves"):
+                        self.inertia_ksp.solve(b, self.dx)
                     x.axpy(-1.0, self.dx)
                     x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
                     new_energy = m.energy()
@@ -233,35 +368,38 @@ class Solver:
                 sigma *= 10.0
                 if sigma > 1e8:
                     diag.destroy()
-                    raise NewtonFailure("descent: no energy decrease")
+                    raise self._fail(steps, "descent: no energy decrease")
             diag.destroy()
             its += 1
+            steps += 1
             if sigma < 1e-4:
                 state = m.get_state()
                 saved = self.options.max_iterations
                 self.options.max_iterations = 8
                 try:
-                    its += self.newton()
+                    newton_its = self.newton()
+                    its += newton_its
                     if self.negative_eigenvalues() == 0:
-                        self.total_iterations += its
+                        self._spent(steps, True)
+                        self.last_iterations = its
                         return its
                 except NewtonFailure:
                     pass
                 finally:
                     self.options.max_iterations = saved
                 m.set_state(state)
-        self.total_iterations += its
-        raise NewtonFailure(f"descent: no stable equilibrium in {max_steps} steps")
+        raise self._fail(steps, f"descent: no stable equilibrium in {max_steps} steps")
 
     # --- stability -------------------------------------------------------------------------
     def negative_eigenvalues(self) -> int:
         """Number of negative eigenvalues of the constrained tangent at the current q
         (inertia of MUMPS's L D L^T factorisation)."""
         A = self.assemble_tangent()
-        self.inertia_ksp.setOperators(A)
-        self.inertia_ksp.setUp()
-        factor = self.inertia_ksp.getPC().getFactorMatrix()
-        nneg, nzero, _npos = factor.getInertia()
+        with self.clock.section("eigenvalues and inertia"):
+            self.inertia_ksp.setOperators(A)
+            self.inertia_ksp.setUp()
+            factor = self.inertia_ksp.getPC().getFactorMatrix()
+            nneg, nzero, _npos = factor.getInertia()
         return int(nneg + nzero)
 
     def lowest_modes(self, count: int = 1, target: float = 0.0):
@@ -271,6 +409,10 @@ class Solver:
         from slepc4py import SLEPc
 
         A = self.assemble_tangent()
+        with self.clock.section("eigenvalues and inertia"):
+            return self._lowest_modes(A, count, target, SLEPc)
+
+    def _lowest_modes(self, A, count, target, SLEPc):
         K = A.copy()
         eps = SLEPc.EPS().create(self.model.mesh.comm)
         eps.setOperators(K, self.M)

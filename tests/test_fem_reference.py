@@ -96,6 +96,36 @@ def test_summary_has_every_base_summary_key():
     assert set(expected) <= set(summary)
 
 
+def test_summary_breaks_down_iterations_and_wall_time_by_phase(tmp_path):
+    """summary.json's newton_iterations_by_phase: one entry per ITERATION_PHASES summing to
+    newton_iterations (compression start, accepted steps, the dW1 bisection and the branch
+    switch all used on a 12 x 10 mesh sheared past the pitchfork), then the counts of failed
+    solves, step halvings and snaps; threshold_newton_iterations = the dW1 and dW2 phases;
+    wall_time_by_phase_s: every TIME_PHASES entry, non-negative except the remainder "other",
+    summing to wall_time_s."""
+    from fem_reference.api import simulate
+    from fem_reference.solver import ITERATION_PHASES, TIME_PHASES
+
+    strip = Strip.from_ratios(1 / 6, 0.5)
+    protocol = LoadingProtocol(0.5, shear_ratio=0.25, compression_steps=2, shear_steps=3)
+    simulate(strip, protocol, 12, out=tmp_path)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["converged"], summary["message"]
+    by_phase = summary["newton_iterations_by_phase"]
+    assert set(ITERATION_PHASES) | {"failed solves", "step halvings", "snaps"} == set(by_phase)
+    assert sum(by_phase[p] for p in ITERATION_PHASES) == summary["newton_iterations"]
+    for phase in ("compression start", "accepted steps", "threshold dW1", "branch switching"):
+        assert by_phase[phase] > 0, (phase, by_phase)
+    assert by_phase["other"] == 0
+    assert summary["threshold_newton_iterations"] == by_phase["threshold dW1"] + by_phase["threshold dW2"]
+    times = summary["wall_time_by_phase_s"]
+    assert set(TIME_PHASES) <= set(times)
+    assert all(times[p] >= 0.0 for p in times if p != "other"), times
+    assert sum(times.values()) == pytest.approx(summary["wall_time_s"], rel=1e-9)
+    assert times["I/O"] > 0.0 and times["threshold location"] > 0.0 and times["branch switching"] > 0.0
+    assert set(summary["wall_time_within_phases_s"]) == {"threshold location", "branch switching"}
+
+
 def test_shear_directions_mirror_and_no_lateral_motion_at_zero(compressed_sixth):
     """+dW and -dW give mirror images (y -> -y) to 1e-9 L; no lateral motion at dW = 0."""
     model, solver, stepper, state = compressed_sixth

@@ -1,21 +1,30 @@
-"""Python API: ddg.simulate(strip, protocol, model="rod") mirrors `python -m ddg simulate`."""
+"""Python API: ddg.simulate(strip, protocol, model="rod") mirrors `python -m ddg simulate`.
+
+The entry points check their inputs, build the model, the stepper and the listeners, and hand
+them to the one loading loop (ddg.protocol.driver.execute): `simulate` (rod, plate, ribbon;
+static or implicit Euler), `run_ribbon` (the Sadowsky ribbon started directly or from the rod).
+"""
 from __future__ import annotations
 
+import dataclasses
 import os
-import platform
-import sys
-import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-import scipy
 
+from .analysis.observables import observe
 from .geometry.strip import InputError, LoadingProtocol, Strip
-from .output.io import write_centerline_csv, write_path_csv, write_summary_json
-from .analysis.observables import observe, resolved_up_to
-from .solve.continuation import ContinuationFailure, ContinuationOptions, PathFollower
-from .solve.state import Snapshot
+from .models.ribbon import RIBBON_INITS
+from .protocol.after import BranchStep, Brackets, ThresholdStep
+from .protocol.driver import AfterStep, Loading, Run, execute
+from .protocol.progress import ProgressBar
+from .protocol.results import DynamicResult, RibbonResult, SimulationResult, base_summary
+from .protocol.steppers import ImplicitEulerStepper, RodDrivenStepper, StaticStepper, dynamic_loading
+from .solve.continuation import ContinuationOptions
+
+__all__ = ["simulate", "run_ribbon", "simulate_dynamic", "make_model", "SimulationResult", "RibbonResult",
+           "DynamicResult"]
 
 DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "ribbon": 101}  # ribbon: M not a multiple of 4, see RibbonModel
 
@@ -67,173 +76,6 @@ def _model_class(name: str):
     return models[check_model_name(name)]
 
 
-@dataclass
-class SimulationResult:
-    rows: list[dict]
-    summary: dict
-    final_state: object = None
-    model: object = None
-    centerlines: list = field(default_factory=list)  # per recorded row: (stations, 3) positions of w = 0
-    branch_rows: list = field(default_factory=list)  # rows of branches.csv (every branch, stable or not)
-
-    @property
-    def converged(self) -> bool:
-        return bool(self.summary["converged"])
-
-    def column(self, name: str, stage: str | None = None) -> np.ndarray:
-        rows = self.rows if stage is None else [r for r in self.rows if r["stage"] == stage]
-        return np.array([r[name] for r in rows])
-
-    def write(self, out: str | Path) -> None:
-        out = Path(out)
-        write_path_csv(out / "path.csv", self.rows)
-        if self.centerlines:
-            write_centerline_csv(out / "centerline.csv", self.rows, self.centerlines, self.strip_length)
-        if self.branch_rows:
-            write_path_csv(out / "branches.csv", self.branch_rows, leading=("branch",))
-        write_summary_json(out / "summary.json", self.summary)
-
-    @property
-    def strip_length(self) -> float:
-        return float(self.summary["scene"]["length"])
-
-
-class ProgressBar:
-    """A one-line progress bar on stderr when it is a terminal."""
-
-    def __init__(self, total: int, enabled: bool):
-        self.total, self.count = total, 0
-        self.enabled = enabled and sys.stderr.isatty()
-
-    def update(self, text: str) -> None:
-        self.count += 1
-        if self.enabled:
-            frac = self.count / self.total
-            bar = "#" * int(30 * frac)
-            sys.stderr.write(f"\r[{bar:<30}] {100 * frac:5.1f}% {text}   ")
-            sys.stderr.flush()
-
-    def close(self) -> None:
-        if self.enabled:
-            sys.stderr.write("\n")
-
-
-def track_brackets(brackets: dict, model, state, phase: str) -> None:
-    """Remember the recorded states that bracket the phase changes U -> US and US -> S."""
-    if phase == "U" and brackets["first_us"] is None:
-        brackets["last_u"] = Snapshot.take(model, state)
-    elif phase.startswith("US"):
-        if brackets["first_us"] is None and brackets["last_u"] is not None:
-            brackets["first_us"] = state.shear
-        if brackets["first_s"] is None:
-            brackets["last_us"] = Snapshot.take(model, state)
-    elif phase.startswith("S") and brackets["first_s"] is None and brackets["last_us"] is not None:
-        brackets["first_s"] = Snapshot.take(model, state)
-
-
-def fill_thresholds(summary: dict, model, options, brackets: dict) -> None:
-    from .solve.thresholds import shear_thresholds
-
-    t0 = time.perf_counter()
-    found = shear_thresholds(model, options, brackets["last_u"], brackets["first_us"], brackets["last_us"],
-                             brackets["first_s"])
-    L = model.strip.length
-    for key, name in (("dW1", "dW1_over_L"), ("dW2", "dW2_over_L"), ("dW2_S_stable", "dW2_S_stable_over_L")):
-        summary[name] = None if found[key] is None else abs(found[key]) / L
-    summary["threshold_wall_time_s"] = time.perf_counter() - t0
-    summary["threshold_newton_iterations"] = found["newton_iterations"]
-
-
-THRESHOLD_KEYS = ("dW1_over_L", "dW2_over_L", "dW2_S_stable_over_L")
-
-
-def check_thresholds_resolved(summary: dict, rows: list[dict]) -> None:
-    """Null every threshold located from states the discretisation does not resolve
-    (ddg.analysis.observables.unresolved_reason); its value and the reason go to
-    `unresolved_thresholds`, a line to `warnings`. No threshold is printed from such a state."""
-    from .analysis.observables import unresolved_reason
-
-    for key in THRESHOLD_KEYS:
-        value = summary.get(key)
-        if value is None:
-            continue
-        reason = unresolved_reason(rows, value)
-        if reason is not None:
-            summary[key] = None
-            summary["unresolved_thresholds"][key] = {"value": value, "reason": reason}
-            summary["warnings"].append(f"{key} = {value:.4g} not reported (unresolved): {reason}")
-
-
-def trace_all_branches(summary: dict, model, options, compressed, shear_max: float, brackets: dict) -> list[dict]:
-    """Every branch of the shear stage by pseudo-arclength (ddg.solve.branches); its rows."""
-    from .solve.branches import trace_branches
-
-    t0 = time.perf_counter()
-    saved = model.save_frames()
-    try:
-        diagram = trace_branches(model, options, compressed, shear_max, brackets["first_s"])
-    finally:
-        model.restore_frames(saved)
-    summary["branches"] = diagram.summary(model.strip.length)
-    summary["branches_newton_iterations"] = diagram.newton_iterations
-    summary["branches_wall_time_s"] = time.perf_counter() - t0
-    return [{"branch": b.name, **observe(model, s, "shear", True)} for b in diagram.branches for s in b.states]
-
-
-def _distinct(values: list[float], tolerance: float) -> list[float]:
-    """values without the ones within tolerance of an earlier one (a fold met by several substeps)."""
-    out: list[float] = []
-    for v in values:
-        if all(abs(v - w) > tolerance for w in out):
-            out.append(v)
-    return out
-
-
-def versions() -> dict:
-    from . import __version__
-
-    return {"ddg": __version__, "python": platform.python_version(), "numpy": np.__version__, "scipy": scipy.__version__}
-
-
-def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resolution: int, model) -> dict:
-    """summary.json before the run: every contract key, inputs with defaults resolved."""
-    L = strip.length
-    return {
-        "model": model_name,
-        "scene": {
-            **strip.as_dict(),
-            **protocol.as_dict(strip),
-            "resolution": resolution,
-            "clamp_convention": "clamped edges (rod) / the two clamped node columns (plate) straddle the clamp "
-                                "points; free length exactly L",
-        },
-        "H_mid_over_L_compressed": None,
-        "dW_max_over_L": strip.shear_limit(protocol.compression_ratio * L) / L,
-        "dW1_over_L": None,
-        "dW2_over_L": None,
-        "dW2_S_stable_over_L": None,
-        "threshold_wall_time_s": None,
-        "threshold_newton_iterations": None,
-        "branches": None,
-        "branches_wall_time_s": None,
-        "folds_dW_over_L": [],
-        "n_dof": model.n_dof,
-        "n_free_dof": int(np.arange(model.n_dof)[model.free].size),
-        "newton_iterations": 0,
-        "newton_iterations_by_phase": None,
-        "wall_time_s": None,
-        "converged": False,
-        "message": "",
-        "status": "running",
-        "path_complete": False,
-        "warnings": [],
-        "unresolved_thresholds": {},
-        "mesh": model.mesh.as_dict() if hasattr(model, "mesh") else None,
-        "lambda_min_normalisation": "lowest eigenvalue of K v = lambda D v (lumped metric D), times L^4 / EI2",
-        "versions": versions(),
-    }
-
-
 def check_model_name(model) -> str:
     """model as one of the available names (a one-line InputError otherwise)."""
     if not isinstance(model, str) or model not in DEFAULT_RESOLUTION:
@@ -274,52 +116,56 @@ MAX_NODES = 5000
 MAX_TRIANGLES = 1_000_000
 
 
-def finish_summary(summary: dict, rows: list[dict], *, path_complete: bool, stopped: str | None,
-                   interrupted: BaseException | None, stage: str, error: BaseException | None = None) -> None:
-    """status, converged and message of a run that ended (every model's loop calls this).
-
-    path_complete: the loading path reached its end; stopped: the ContinuationFailure message if
-    it did not; interrupted: the KeyboardInterrupt (SIGINT/SIGTERM) that stopped the run, in
-    `stage`; error: an unexpected exception."""
-    from .output.interrupts import signal_name_of
-    from .output.io import STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED
-
-    summary["path_complete"] = bool(path_complete)
-    summary["recorded_steps"] = len(rows)
-    summary["resolved_up_to_dW_over_L"] = resolved_up_to(rows)
-    kept = f"{len(rows)} converged steps written" if rows else "no step had converged"
-    if error is not None:
-        summary.update(status="error", converged=False,
-                       message=f"internal error during {stage}: {type(error).__name__}: {error}; {kept}")
-    elif interrupted is not None:
-        what = "the path is complete; " if path_complete else ""
-        summary.update(status=STATUS_INTERRUPTED, converged=False,
-                       message=f"interrupted by {signal_name_of(interrupted)} during {stage}; {what}{kept}")
-    elif stopped is not None:
-        summary.update(status=STATUS_STOPPED, converged=False, message=stopped)
-    else:
-        summary.update(status=STATUS_COMPLETE, converged=True, message="path complete")
 
 
-def conclude_run(folder, result, interrupted: BaseException | None, error: BaseException | None):
-    """Write the result's files into its folder (atomically, signals held) and return it; an
-    interruption or an unexpected error is re-raised after that, with the result as exc.result."""
-    if folder is not None:
-        folder.finish(result)
-    if interrupted is not None or error is not None:
-        raised = interrupted if interrupted is not None else error
-        raised.result = result
-        raise raised
-    return result
-
-
-def open_run_folder(out, summary: dict, trailing: tuple[str, ...] = ()):
+def _open_folder(out, summary: dict):
     """The RunFolder of `out` (None if out is None), marked in progress with this summary."""
     if out is None:
         return None
     from .output.io import RunFolder
 
-    return RunFolder(out, summary, trailing=trailing)
+    return RunFolder(out, summary)
+
+
+def _recorders(model, folder, progress_bar, writer=None):
+    """Listeners every model's run has: path.csv row by row, the centerline per row, frames,
+    progress; returns (listeners, centerlines)."""
+    centerlines: list[np.ndarray] = []
+
+    def keep_centerline(stage, state, row):
+        centerlines.append(model.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
+
+    listeners = []
+    if folder is not None:
+        listeners.append(lambda stage, state, row: folder.append(row))
+    listeners.append(keep_centerline)
+    if writer is not None:
+        def write_frame(stage, state, row):
+            writer.write(model.positions(state.q), step=len(centerlines) - 1, dL_over_L=row["dL_over_L"],
+                         dW_over_L=row["dW_over_L"], stage=stage)
+
+        listeners.append(write_frame)
+    listeners.append(progress_bar)
+    return listeners, centerlines
+
+
+def _checked_options(options) -> ContinuationOptions:
+    if options is not None and not isinstance(options, ContinuationOptions):
+        raise InputError(f"options = {options!r} must be a ddg.ContinuationOptions")
+    return replace(options) if options is not None else ContinuationOptions()  # re-validated
+
+
+def _checked_scene(strip, protocol) -> None:
+    if not isinstance(strip, Strip):
+        raise InputError(f"strip = {strip!r} must be a ddg.Strip")
+    if not isinstance(protocol, LoadingProtocol):
+        raise InputError(f"protocol = {protocol!r} must be a ddg.LoadingProtocol")
+
+
+def _checked_flags(**flags) -> None:
+    for name, value in flags.items():
+        if not isinstance(value, (bool, np.bool_)):
+            raise InputError(f"{name} = {value!r} must be True or False")
 
 
 def simulate(
@@ -356,28 +202,23 @@ def simulate(
     threshold whose states the discretisation does not resolve is reported null, with its
     value and the reason under `unresolved_thresholds` and in `warnings`.
     branches=True (with thresholds; default None: True for the rod, False for the plate, whose
-    diagram costs more than its path, 440 s against 265 s at 2000 triangles) then traces every branch of the shear stage by
-    pseudo-arclength continuation, stable and unstable parts, through folds (U, US+, US-, and
+    diagram costs more than its path, 440 s against 265 s at 2000 triangles) then traces every
+    branch of the shear stage by pseudo-arclength continuation, stable and unstable parts, through folds (U, US+, US-, and
     S from the first S state of the path; ddg.solve.branches): rows in result.branch_rows and
     out/branches.csv (path.csv's columns after a `branch` column), per-branch summary under
     the summary key `branches`.
     """
-    if not isinstance(strip, Strip):
-        raise InputError(f"strip = {strip!r} must be a ddg.Strip")
-    if not isinstance(protocol, LoadingProtocol):
-        raise InputError(f"protocol = {protocol!r} must be a ddg.LoadingProtocol")
+    _checked_scene(strip, protocol)
     if not isinstance(solver, str) or solver not in ("static", "dynamic"):
         raise InputError(f"solver = {solver!r} is not available; choose 'static' or 'dynamic'")
     check_model_name(model)
     if options is not None and not isinstance(options, ContinuationOptions):
         raise InputError(f"options = {options!r} must be a ddg.ContinuationOptions")
-    for name, value in (("progress", progress), ("frames", frames), ("thresholds", thresholds)):
-        if not isinstance(value, (bool, np.bool_)):
-            raise InputError(f"{name} = {value!r} must be True or False")
+    _checked_flags(progress=progress, frames=frames, thresholds=thresholds)
     if branches is not None and not isinstance(branches, (bool, np.bool_)):
         raise InputError(f"branches = {branches!r} must be True, False or None")
     resolution = check_resolution(model, resolution, strip, mesh)
-    shear_ratio = protocol.resolved_shear_ratio(strip)
+    protocol.resolved_shear_ratio(strip)
     if out is not None:
         from .output.io import check_output_directory
 
@@ -387,8 +228,6 @@ def simulate(
             raise InputError(f"solver = 'dynamic' is available for model 'rod' only, not {model!r}")
         if frames or mesh is not None:
             raise InputError("frames and mesh are options of the static solver; drop them or use solver='static'")
-        from .solve.dynamics import simulate_dynamic
-
         return simulate_dynamic(strip, protocol, resolution, dynamic_options, out=out)
     if dynamic_options is not None:
         raise InputError("dynamic_options apply to solver='dynamic' only")
@@ -396,85 +235,127 @@ def simulate(
     instance = make_model(model, strip, resolution, mesh)
     if frames and out is None:
         raise InputError("frames=True needs an output directory (out)")
-    options = replace(options) if options is not None else ContinuationOptions()  # re-validated
-    follower = PathFollower(instance, options)
-    L = strip.length
-    dL = protocol.compression_ratio * L
-    dW = protocol.shear_sign * shear_ratio * L
+    options = _checked_options(options)
+    return _static_run(model, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,
+                       frames=frames)
 
-    rows: list[dict] = []
-    centerlines: list[np.ndarray] = []
-    summary = base_summary(model, strip, protocol, resolution, instance)
-    folder = open_run_folder(out, summary)
+
+def _static_run(name, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,
+                frames=False, summary_extra=None, stepper=None, result=SimulationResult):
+    """A static run of `instance` (or of `stepper`'s model) through the driver: the rows,
+    the thresholds from the model's own stability, the branches (if asked)."""
+    loading = Loading.equally_spaced(strip, protocol)
+    summary = base_summary(name, strip, protocol, resolution, instance)
+    summary.update(summary_extra or {})
+    folder = _open_folder(out, summary)
     writer = _frame_writer(instance, Path(out) / "frames") if frames else None
-    progress_bar = ProgressBar(protocol.compression_steps + protocol.shear_steps + 1, progress)
-    t0 = time.perf_counter()
-    state = None
+    bar = ProgressBar(len(loading.compression) + len(loading.shear) + 1, progress)
+    listeners, centerlines = _recorders(instance, folder, bar, writer)
+    stepper = stepper or StaticStepper(instance, options)
+    after, on_compressed, branch_step = [], [], None
+    extra_rows = {}
+    if isinstance(stepper, RodDrivenStepper):
+        rod, rod_rows = stepper.rod, []
+        extra_rows["rod_rows"] = rod_rows
+        rod_brackets = Brackets(rod)
 
-    brackets = {"last_u": None, "first_us": None, "last_us": None, "first_s": None}
-    compressed = None
-    branch_rows: list[dict] = []
+        def rod_row(stage, state, row):
+            rod_rows.append(observe(rod, stepper.driven, stage, options.eigenvalues))
+            rod_brackets(stage, stepper.driven, rod_rows[-1])
 
-    def record(stage):
-        row = observe(instance, state, stage, options.eigenvalues)
-        rows.append(row)
-        if folder is not None:
-            folder.append(row)
-        if stage == "shear" and thresholds:
-            track_brackets(brackets, instance, state, row["phase"])
-        centerlines.append(instance.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
-        if writer is not None:
-            writer.write(instance.positions(state.q), step=len(rows) - 1, dL_over_L=row["dL_over_L"],
-                         dW_over_L=row["dW_over_L"], stage=stage)
-        progress_bar.update(f"{stage} dL/L={row['dL_over_L']:.4f} dW/L={row['dW_over_L']:.4f}")
+        listeners.insert(0, rod_row)
+        if thresholds and options.eigenvalues:
+            after.append(ThresholdStep(summary, rod, options, rod_brackets, rows=rod_rows, prefix="rod_"))
+    elif thresholds and options.eigenvalues:
+        brackets = Brackets(instance)
+        listeners.insert(1 if folder is not None else 0, brackets)
+        after.append(ThresholdStep(summary, instance, options, brackets))
+        if branches and loading.shear:
+            branch_step = BranchStep(summary, instance, options, loading.shear[-1], brackets)
+            on_compressed.append(branch_step.remember_compressed)
+            after.append(branch_step)
+    if folder is not None:
+        shearing = "running: compression complete, shearing"
+        on_compressed.append(lambda outcome: folder.checkpoint({**summary, "message": shearing}))
 
-    stage, stopped, interrupted, error, path_complete = "compression", None, None, None, False
-    try:
-        state = follower.rest()
-        record("compression")
-        for k in range(1, protocol.compression_steps + 1):
-            target = dL * k / protocol.compression_steps
-            state = follower.start_compression(target) if k == 1 else follower.advance(state, target, 0.0)
-            record("compression")
-        summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
-        compressed = Snapshot.take(instance, state)
-        if folder is not None:
-            folder.checkpoint({**summary, "message": "running: compression complete, shearing"})
-        stage = "shear"
-        for k in range(1, protocol.shear_steps + 1 if dW != 0.0 else 1):
-            state = follower.advance(state, dL, dW * k / protocol.shear_steps)
-            record("shear")
-        path_complete = True
-    except ContinuationFailure as exc:
-        stopped = str(exc)
-    except KeyboardInterrupt as exc:
-        interrupted = exc
-    except Exception as exc:  # noqa: BLE001  (written as status "error", then re-raised)
-        error = exc
-    progress_bar.close()
-    try:
-        if interrupted is None and error is None and thresholds and options.eigenvalues and state is not None:
-            if folder is not None:
-                folder.checkpoint({**summary, "message": "running: path done, locating thresholds"})
-            stage = "threshold location"
-            fill_thresholds(summary, instance, options, brackets)
-            check_thresholds_resolved(summary, rows)
-            if branches and compressed is not None and dW != 0.0:
-                stage = "branch tracing"
-                if folder is not None:
-                    folder.checkpoint({**summary, "message": "running: thresholds located, tracing branches"})
-                branch_rows = trace_all_branches(summary, instance, options, compressed, dW, brackets)
-    except KeyboardInterrupt as exc:
-        interrupted = exc
-    except Exception as exc:  # noqa: BLE001
-        error = exc
-    summary["newton_iterations"] = follower.newton_iterations
-    summary["newton_iterations_by_phase"] = follower.iteration_breakdown()
-    summary["folds_dW_over_L"] = _distinct([abs(f) / L for f in follower.folds], 1e-4)
-    summary["wall_time_s"] = time.perf_counter() - t0
-    finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
-                   stage=stage, error=error)
-    if writer is not None:
-        writer.close()
-    result = SimulationResult(rows, summary, state, instance, centerlines, branch_rows)
-    return conclude_run(folder, result, interrupted, error)
+    def compressed(outcome):
+        for hook in on_compressed:
+            hook(outcome)
+
+    def make_result(outcome):
+        return result(outcome.rows, summary, outcome.state, instance, centerlines,
+                      branch_step.rows if branch_step is not None else [], **extra_rows)
+
+    closers = [bar.close] + ([writer.close] if writer is not None else [])
+    run = Run(stepper, loading, lambda stage, state: observe(instance, state, stage, options.eigenvalues), summary,
+              listeners, folder, [AfterStep(step.stage, step.run, step.checkpoint) for step in after], compressed, make_result, closers)
+    return execute(run)
+
+
+def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", zeta: float | None = None,
+               resolution: int | None = None, out=None, options: ContinuationOptions | None = None,
+               thresholds: bool = True, progress: bool = False) -> RibbonResult:
+    """The ribbon (Eq. A.5) through the two-stage protocol, started "direct" or from the "rod".
+
+    Rows, summary and centerlines as ddg.simulate (path.csv, summary.json, centerline.csv);
+    summary adds ribbon_init, zeta, zeta_over_L. init="direct" locates dW1 from the ribbon's own
+    stability where its path leaves U (None if it never does); init="rod" reports the rod's
+    thresholds as rod_dW1_over_L, rod_dW2_over_L and writes the rod's rows to rod_path.csv.
+    """
+    from .models.ribbon import RibbonModel
+    from .models.rod import RodModel
+
+    if init not in RIBBON_INITS:
+        raise InputError(f"ribbon init = {init!r} is not available; choose one of {list(RIBBON_INITS)}")
+    if not isinstance(strip, Strip) or not isinstance(protocol, LoadingProtocol):
+        raise InputError("run_ribbon needs a ddg.Strip and a ddg.LoadingProtocol")
+    resolution = check_resolution("ribbon", resolution)
+    if out is not None:
+        from .output.io import check_output_directory
+
+        check_output_directory(out)
+    options = _checked_options(options)
+    ribbon = RibbonModel(strip, resolution, zeta=zeta)
+    stepper = RodDrivenStepper(ribbon, RodModel(strip, resolution), options) if init == "rod" \
+        else StaticStepper(ribbon, options, folds=False)
+    L = strip.length
+    return _static_run("ribbon", ribbon, strip, protocol, resolution, options, out, progress, thresholds, False,
+                       summary_extra={"ribbon_init": init, "zeta": ribbon.zeta, "zeta_over_L": ribbon.zeta / L},
+                       stepper=stepper, result=RibbonResult)
+
+
+def simulate_dynamic(strip: Strip, protocol: LoadingProtocol, resolution: int = 100, options=None,
+                     out: str | Path | None = None) -> DynamicResult:
+    """The two-stage protocol of ddg.simulate (model "rod") by implicit-Euler time marching.
+
+    Stage 1 moves the clamp at s = L along -x at options.clamp_speed until dL = protocol
+    .compression_ratio L; stage 2 moves it along y (sign protocol.shear_sign) until
+    dW = protocol.resolved_shear_ratio(strip) L. Rows (the columns of ddg.analysis.observables
+    .observe) are recorded at the static solver's loads, which the time steps hit exactly; the
+    summary has the static summary's keys plus "solver": "implicit-euler", the options under
+    scene["dynamics"]. On a Newton failure the step is halved up to options.max_halvings times;
+    then the run stops with converged=False, keeping the rows so far.
+    """
+    from .models.rod import RodModel
+    from .solve.dynamics import DynamicOptions
+
+    _checked_scene(strip, protocol)
+    if options is not None and not isinstance(options, DynamicOptions):
+        raise InputError(f"options = {options!r} must be a ddg.solve.dynamics.DynamicOptions")
+    options = dataclasses.replace(options) if options is not None else DynamicOptions()  # re-validated
+    options.check_scene(strip, protocol)
+    model = RodModel(strip, resolution)
+    summary = base_summary("rod", strip, protocol, resolution, model)
+    summary["solver"] = "implicit-euler"
+    summary["scene"]["dynamics"] = dataclasses.asdict(options)
+    folder = _open_folder(out, summary)
+    stepper = ImplicitEulerStepper(model, options)
+    listeners = [lambda stage, state, row: folder.append(row)] if folder is not None else []
+
+    def make_result(outcome):
+        return DynamicResult(outcome.rows, summary, outcome.state, model, trace=stepper.trace)
+
+    run = Run(stepper, dynamic_loading(strip, protocol, options),
+              lambda stage, state: observe(model, state, stage, options.eigenvalues), summary, listeners, folder,
+              make_result=make_result)
+    return execute(run)

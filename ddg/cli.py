@@ -293,7 +293,7 @@ def cmd_simulate(args) -> int:
         dynamic_options = DynamicOptions(clamp_speed=1e-3 if args.clamp_speed is None else args.clamp_speed)
         dynamic_options.check_scene(strip, protocol)
     if args.model == "ribbon":
-        from .ribbon_runs import run_ribbon
+        from .api import run_ribbon
 
         if args.solver != "static" or args.mesh is not None or args.frames:
             raise InputError("--model ribbon runs the static solver only, without --mesh or --frames")

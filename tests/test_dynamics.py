@@ -8,7 +8,8 @@ import ddg.solve.dynamics as dynamics
 from ddg.api import SimulationResult
 from ddg.models.rod import RodModel
 from ddg.analysis.observables import observe
-from ddg.solve.dynamics import DynamicOptions, ImplicitEuler, IncrementalPotential, simulate_dynamic
+from ddg.api import simulate_dynamic
+from ddg.solve.dynamics import DynamicOptions, ImplicitEuler, IncrementalPotential
 from ddg.solve.newton import scaled_residual
 
 STRIP = ddg.Strip.from_ratios(width_ratio=0.05, compression_ratio=0.25)  # L = 0.1 m

@@ -17,7 +17,7 @@ from ddg.cli import main
 from ddg.output.io import read_path_csv
 from ddg.models.ribbon import DEFAULT_ZETA_OVER_L, RibbonModel
 from ddg.analysis.pitchfork import pitchfork_analysis
-from ddg.ribbon_runs import run_ribbon
+from ddg.api import run_ribbon
 
 STRIP = ddg.Strip.from_ratios(0.05, 0.5)
 L = STRIP.length

@@ -16,25 +16,20 @@ frames parallel-transported in time (the model's commit), as in the paper.
 Outputs are those of ddg.simulate: rows recorded at the loads where the static solver
 records (or every `record_interval` seconds), evaluated with the bare elastic energy, so
 `energy`, the clamp forces, `lambda_min` and `stable` describe the elastic state that the
-dynamics has reached; how far it is from equilibrium is in `DynamicResult.trace`.
+dynamics has reached; how far it is from equilibrium is in `DynamicResult.trace`. The loading
+loop itself is the one of every model (ddg.protocol.driver, ImplicitEulerStepper).
 """
 from __future__ import annotations
 
 import dataclasses
 import math
-import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
-from ..api import SimulationResult, base_summary, conclude_run, finish_summary, open_run_folder
 from ..geometry.strip import InputError, LoadingProtocol, Strip
-from ..analysis.observables import observe
 from .banded import SymmetricBanded
-from .continuation import ContinuationFailure, ContinuationOptions, PathFollower
-from .state import State
-from .newton import NewtonOptions, newton, scaled_residual
+from .newton import NewtonOptions, newton
 
 
 @dataclass
@@ -263,123 +258,9 @@ class ImplicitEuler:
         return 0.5 * float(np.dot(m * self.v, self.v))
 
 
-@dataclass
-class DynamicResult(SimulationResult):
-    """SimulationResult plus, per recorded row, the time, kinetic energy and static residual."""
-
-    trace: list = field(default_factory=list)
-
-
-def _targets(total: float, steps: int, duration: float, record_interval: float | None) -> np.ndarray:
+def recorded_targets(total: float, steps: int, duration: float, record_interval: float | None) -> np.ndarray:
+    """The recorded loads of one stage (m): `steps` equal steps to `total`, or, with a
+    record_interval (s), one every ~record_interval of the `duration` (s) the clamp takes."""
     if record_interval is not None:
         steps = max(1, math.ceil(duration / record_interval - 1e-9)) if duration > 0 else 1
     return total * np.arange(1, steps + 1) / steps
-
-
-def simulate_dynamic(
-    strip: Strip,
-    protocol: LoadingProtocol,
-    resolution: int = 100,
-    options: DynamicOptions | None = None,
-    out: str | Path | None = None,
-) -> DynamicResult:
-    """The two-stage protocol of ddg.simulate (model "rod") by implicit-Euler time marching.
-
-    Stage 1 moves the clamp at s = L along -x at options.clamp_speed until dL = protocol
-    .compression_ratio L; stage 2 moves it along y (sign protocol.shear_sign) until
-    dW = protocol.resolved_shear_ratio(strip) L. Rows (the columns of ddg.analysis.observables.observe)
-    are recorded at the static solver's loads, which the time steps hit exactly; the summary
-    has the static summary's keys plus "solver": "implicit-euler", the options under
-    scene["dynamics"]. On a Newton failure the step is halved up to options.max_halvings times;
-    then the run stops with converged=False, keeping the rows so far.
-    """
-    from ..models.rod import RodModel
-
-    if not isinstance(strip, Strip):
-        raise InputError(f"strip = {strip!r} must be a ddg.Strip")
-    if not isinstance(protocol, LoadingProtocol):
-        raise InputError(f"protocol = {protocol!r} must be a ddg.LoadingProtocol")
-    if options is not None and not isinstance(options, DynamicOptions):
-        raise InputError(f"options = {options!r} must be a ddg.solve.dynamics.DynamicOptions")
-    options = dataclasses.replace(options) if options is not None else DynamicOptions()  # re-validated
-    options.check_scene(strip, protocol)
-    shear_ratio = protocol.resolved_shear_ratio(strip)
-    model = RodModel(strip, resolution)
-    L = strip.length
-    v = options.clamp_speed
-    dL = protocol.compression_ratio * L
-    dW = protocol.shear_sign * shear_ratio * L
-    compressions = _targets(dL, protocol.compression_steps, dL / v, options.record_interval)
-    shears = _targets(dW, protocol.shear_steps, abs(dW) / v, options.record_interval)
-
-    summary = base_summary("rod", strip, protocol, resolution, model)
-    summary["solver"] = "implicit-euler"
-    summary["scene"]["dynamics"] = dataclasses.asdict(options)
-    folder = open_run_folder(out, summary)
-    rows: list[dict] = []
-    trace: list[dict] = []
-    t0 = time.perf_counter()
-    state = None
-    integrator = None
-    start_iterations = 0
-
-    def record(stage: str, q: np.ndarray, load, iterations: int, kinetic: float, t: float):
-        ev = model.evaluate(q)
-        stable = bool(model.free_matrix(ev.hessian).cholesky())
-        st = State(q, ev, float(load[0]), float(load[1]), stable, iterations)
-        rows.append(observe(model, st, stage, options.eigenvalues))
-        if folder is not None:
-            folder.append(rows[-1])
-        trace.append({"time": t, "kinetic_energy": kinetic, "static_residual": scaled_residual(model, ev.gradient)})
-        return st
-
-    stage, stopped, interrupted, error, path_complete = "compression", None, None, None, False
-    try:
-        # the rest state, recorded as the static solver does
-        q_rest = model.reset()
-        state = record("compression", q_rest, (0.0, 0.0), 0, 0.0, 0.0)
-        # start: buckled guess at the first recorded compression (see DynamicOptions.relax_start)
-        first = float(compressions[0])
-        if options.relax_start:
-            follower = PathFollower(model, ContinuationOptions(newton=options.newton))
-            start = follower.start_compression(first)  # may halve the compression if needed
-            q0, c0 = start.q, start.compression
-            start_iterations = follower.newton_iterations
-        else:
-            model.reset()
-            q0 = model.apply_clamps(model.buckled_guess(first), first, 0.0)
-            c0 = first
-        model.commit(q0)
-        integrator = ImplicitEuler(model, options, q0, (c0, 0.0))
-        integrator.t = c0 / v
-        integrator.newton_iterations = start_iterations
-        pending = start_iterations
-        for k, target in enumerate(compressions):
-            if k > 0 or c0 < target:
-                pending += integrator.advance((float(target), 0.0), (float(target) - integrator.load[0]) / v)
-            state = record("compression", integrator.q, integrator.load, pending, integrator.kinetic_energy(), integrator.t)
-            pending = 0
-        summary["H_mid_over_L_compressed"] = rows[-1]["H_mid_over_L"]
-        stage = "shear"
-        for target in shears if dW != 0.0 else ():  # as ddg.simulate: no shear rows when dW = 0
-            pending = integrator.advance((dL, float(target)), abs(float(target) - integrator.load[1]) / v)
-            state = record("shear", integrator.q, integrator.load, pending, integrator.kinetic_energy(), integrator.t)
-        path_complete = True
-    except StepFailure as exc:
-        c, s = integrator.load
-        stopped = (
-            f"implicit Euler failed to converge beyond dL/L = {c / L:.6g}, dW/L = {s / L:.6g} "
-            f"(t = {integrator.t:.6g} s; time step halved {options.max_halvings} times to {exc.args[0]:.3g} s)"
-        )
-    except ContinuationFailure as exc:
-        stopped = f"implicit Euler could not start: {exc}"
-    except KeyboardInterrupt as exc:
-        interrupted = exc
-    except Exception as exc:  # noqa: BLE001  (written as status "error", then re-raised)
-        error = exc
-    summary["newton_iterations"] = integrator.newton_iterations if integrator is not None else start_iterations
-    summary["wall_time_s"] = time.perf_counter() - t0
-    finish_summary(summary, rows, path_complete=path_complete, stopped=stopped, interrupted=interrupted,
-                   stage=stage, error=error)
-    result = DynamicResult(rows, summary, state, model, trace=trace)
-    return conclude_run(folder, result, interrupted, error)

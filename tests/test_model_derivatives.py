@@ -44,6 +44,7 @@ from ddg.geometry.plate_mesh import mesh_from_arrays
 from ddg.models.plate import PlateModel
 from ddg.models.ribbon import RibbonModel
 from ddg.models.rod import RodModel
+from rod_states import rod_dof_scale, twisted_rod_state
 
 LENGTH = 0.1
 SEEDS = (0, 1, 2)
@@ -278,33 +279,13 @@ def rod_family_model(kind: str, nodes: int) -> RodModel:
     raise ValueError(kind)
 
 
-def rod_scale(model: RodModel) -> np.ndarray:
-    """The edge spacing h for positions, 1 rad for twist angles."""
-    scale = np.full(model.n_dof, model.centerline.spacing)
-    scale[model.theta_dofs] = 1.0
-    return scale
 
 
-def twisted_state(model: RodModel, seed: int) -> np.ndarray:
-    """A generic 3-D twisted state reached from rest through 3-5 random perturbations, each
-    committed (positions by std 0.085 h per coordinate, twist angles by std 0.3 rad), so that
-    frames are transported along non-planar paths and the reference twist is non-zero; q is
-    committed on return (as tests/test_rod_energies.deformed_twisted_state)."""
-    rng = np.random.default_rng(seed)
-    h = model.centerline.spacing
-    q = model.reset()
-    for _ in range(3 + seed % 3):
-        dq = np.zeros(model.n_dof)
-        dq[model.node_dofs] = 0.085 * h * rng.standard_normal(model.node_dofs.shape)
-        dq[model.theta_dofs] = 0.3 * rng.standard_normal(model.theta_dofs.size)
-        q = q + dq
-        model.commit(q)
-    return q
 
 
 def rod_family_case(kind: str, nodes: int, seed: int) -> tuple[RodModel, np.ndarray]:
     model = rod_family_model(kind, nodes)
-    return model, twisted_state(model, seed)
+    return model, twisted_rod_state(model, seed)
 
 
 # --------------------------------------------------------------------------- plate
@@ -383,7 +364,7 @@ def test_rod_and_ribbon_gradient_and_hessian_match_finite_differences(kind, node
     no committed frame."""
     model, q = rod_family_case(kind, nodes, seed)
     energy = model.evaluate(q, gradient=False, hessian=False).energy
-    errors = derivative_errors(model, q, rod_scale(model))
+    errors = derivative_errors(model, q, rod_dof_scale(model))
     assert errors["gradient"] < GRADIENT_RTOL, describe(errors)
     assert errors["hessian"] < HESSIAN_RTOL, describe(errors)
     assert model.evaluate(q, gradient=False, hessian=False).energy == energy
@@ -417,7 +398,7 @@ def test_hessian_is_the_second_derivative_of_the_energy_along_a_line(family, var
         q, scale = bent_perturbed_plate(model, seed), plate_scale(model)
     else:
         model, q = rod_family_case(family, variant, seed)
-        scale = rod_scale(model)
+        scale = rod_dof_scale(model)
     first, second, energy = taylor_remainders(model, q, scale, seed)
     figures = (f"r1 = {first[0]:.3e}, {first[1]:.3e} (ratio {first[0] / first[1]:.3f}); "
                f"r2 = {second[0]:.3e}, {second[1]:.3e} (ratio {second[0] / second[1]:.3f}); E = {energy:.3e}")

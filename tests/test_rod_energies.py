@@ -26,6 +26,7 @@ from ddg.energies.rod_curvature import material_curvatures, strain_derivatives, 
 from ddg.energies.rod_twist import discrete_twist, twisting_density
 from ddg.energies.stretch import stretching_energy, two_node_blocks
 from ddg.models.rod import RodModel
+from rod_states import rod_dof_scale, twisted_rod_state
 
 # Moderate stiffness contrast: EA h^2 / EI1 ~ 50, EI1 / EI2 = 25, EI2 / GJ ~ 0.65.
 STRIP = Strip(length=0.1, width=0.01, thickness=0.002, young_modulus=1e9, poisson_ratio=0.3)
@@ -50,35 +51,13 @@ def assert_symmetric(hess: np.ndarray) -> None:
     assert np.linalg.norm(hess - sym) <= ROUNDOFF * 1e-3 * np.linalg.norm(hess)
 
 
-def dof_scale(model: RodModel) -> np.ndarray:
-    """Natural size of each DOF: the spacing h for positions, 1 rad for twist angles."""
-    scale = np.full(model.n_dof, model.centerline.spacing)
-    scale[model.theta_dofs] = 1.0
-    return scale
 
 
-def deformed_twisted_state(model: RodModel, seed: int) -> np.ndarray:
-    """A generic state: 3-5 successive random perturbations of the rest state, each committed.
-
-    Positions move by ~0.15 h per step (std 0.085 h per component), twist angles by ~0.3 rad,
-    so tangents leave the plane, frames are transported along non-planar paths and the
-    reference twist is non-zero.
-    """
-    rng = np.random.default_rng(seed)
-    h = model.centerline.spacing
-    q = model.reset()
-    for _ in range(3 + seed % 3):
-        dq = np.zeros(model.n_dof)
-        dq[model.node_dofs] = 0.085 * h * rng.standard_normal((model.nodes, 3))
-        dq[model.theta_dofs] = 0.3 * rng.standard_normal(model.nodes - 1)
-        q = q + dq
-        model.commit(q)
-    return q
 
 
 def committed_model_and_state(nodes: int, seed: int) -> tuple[RodModel, np.ndarray]:
     model = RodModel(STRIP, nodes)
-    q = deformed_twisted_state(model, seed)
+    q = twisted_rod_state(model, seed)
     return model, q
 
 
@@ -168,7 +147,7 @@ def finite_differences(func, q: np.ndarray, scale: np.ndarray):
 def model_energy_and_gradient(model: RodModel):
     def func(q):
         ev = model.evaluate(q, gradient=True, hessian=False)
-        return ev.energy, ev.gradient * dof_scale(model)
+        return ev.energy, ev.gradient * rod_dof_scale(model)
 
     return func
 
@@ -260,7 +239,7 @@ def test_curvature_and_twist_derivatives_match_finite_differences(nodes, seed):
     """kappa_n, kappa_g and tau: stencil gradients match FD of the values, Hessians the
     symmetrised FD Jacobian of the gradients (frames transported from the committed state)."""
     model, q = committed_model_and_state(nodes, seed)
-    scale = dof_scale(model)
+    scale = rod_dof_scale(model)
     index = stencil_dofs(model)
     sscale = scale[index]  # (n, 11)
     n_st = nodes - 2
@@ -311,7 +290,7 @@ def test_each_energy_gradient_and_hessian_match_finite_differences(name, nodes, 
     """Stretching, bending and twisting separately: gradient = FD of the energy, Hessian =
     symmetrised FD Jacobian of that energy's own gradient."""
     model, q = committed_model_and_state(nodes, seed)
-    scale = dof_scale(model)
+    scale = rod_dof_scale(model)
     energy, grad, hess = energy_part(model, q, name)
     assert energy > 0.0
 
@@ -356,7 +335,7 @@ def test_total_gradient_and_hessian_match_finite_differences(nodes, seed):
     """The model's gradient is the FD gradient of its energy and its banded Hessian the
     symmetrised FD Jacobian of its gradient, at a committed generic state."""
     model, q = committed_model_and_state(nodes, seed)
-    scale = dof_scale(model)
+    scale = rod_dof_scale(model)
     ev = model.evaluate(q)
     hess = ev.hessian.to_dense()
     fd_grad, fd_jac = finite_differences(model_energy_and_gradient(model), q, scale)
@@ -510,7 +489,7 @@ def test_internal_forces_and_moments_are_balanced(nodes, seed):
     forces = ev.gradient[model.node_dofs]
     assert np.linalg.norm(forces.sum(axis=0)) < ROUNDOFF * np.linalg.norm(forces)
 
-    scale = dof_scale(model)
+    scale = rod_dof_scale(model)
     tangents = model.frames(q)[0]
     x = model.positions(q)
     x = x - x.mean(axis=0)  # rotation about the centroid (translations already checked)

@@ -19,6 +19,7 @@ from ddg.energies.sadowsky import quartic_twist_term, sadowsky_density
 from ddg.geometry.strip import InputError
 from ddg.models.ribbon import RibbonModel
 from ddg.models.rod import RodModel
+from rod_states import twisted_rod_state
 
 # a strip with moderate stiffness contrast (as in test_rod_energies) so no term dominates
 STRIP = Strip(length=0.1, width=0.01, thickness=0.002, young_modulus=1e9, poisson_ratio=0.0)
@@ -31,24 +32,8 @@ def rel_err(approx, exact) -> float:
     return float(np.linalg.norm(np.asarray(approx) - exact) / np.linalg.norm(exact))
 
 
-def dof_scale(model) -> np.ndarray:
-    scale = np.full(model.n_dof, model.centerline.spacing)
-    scale[model.theta_dofs] = 1.0
-    return scale
 
 
-def deformed_twisted_state(model, seed: int) -> np.ndarray:
-    """3-5 committed random perturbations of the rest state (generic 3-D, twisted)."""
-    rng = np.random.default_rng(seed)
-    h = model.centerline.spacing
-    q = model.reset()
-    for _ in range(3 + seed % 3):
-        dq = np.zeros(model.n_dof)
-        dq[model.node_dofs] = 0.085 * h * rng.standard_normal((model.nodes, 3))
-        dq[model.theta_dofs] = 0.3 * rng.standard_normal(model.nodes - 1)
-        q = q + dq
-        model.commit(q)
-    return q
 
 
 def stencil_state(model, q):
@@ -91,7 +76,7 @@ def test_zero_twist_reduces_to_the_rod_bending_energy(seed):
     with EI1 = 0 its out-of-plane part alone; the second partials differ only by the twist's GJ / dl
     (the quartic term has zero second derivatives at tau = 0)."""
     model = RodModel(STRIP, 12)
-    q = deformed_twisted_state(model, seed)
+    q = twisted_rod_state(model, seed)
     model.commit(q)
     kn, kg, tau = stencil_state(model, q)
     zero = np.zeros_like(tau)
@@ -119,7 +104,7 @@ def test_density_partials_match_finite_differences(seed):
     """The partials of Eq. (A.5) in (kappa_n, kappa_g, tau) that the compiled chain rule uses:
     first partials = central differences of the energy, second = of the first."""
     model = RodModel(STRIP, 12)
-    q = deformed_twisted_state(model, seed)
+    q = twisted_rod_state(model, seed)
     model.commit(q)
     strains = np.stack(stencil_state(model, q), axis=1)
     dl = model.voronoi_lengths
@@ -139,7 +124,7 @@ def test_density_partials_match_finite_differences(seed):
 def test_sadowsky_limit_with_gj_equal_2ei2():
     """nu = 0 (GJ = 2 EI2), zeta -> inf: E_i = EI2 / (2 dl) (kn^2 + tau^2)^2 / kn^2 + EI1 kg^2 / (2 dl), Eq. (A.4)."""
     model = RodModel(STRIP, 12)
-    q = deformed_twisted_state(model, 1)
+    q = twisted_rod_state(model, 1)
     model.commit(q)
     kn, kg, tau = stencil_state(model, q)
     dl = model.voronoi_lengths

@@ -12,15 +12,13 @@ collection of complete frames. meshio is imported lazily (Debian python3-meshio)
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
 from ..geometry.strip import InputError
-from .io import atomic_write_text
+from .io import atomic_path, atomic_write_text
 
 #: Nodes per cell of the supported cell types.
 CELL_NODES = {"triangle": 3, "line": 2}
@@ -154,9 +152,7 @@ class FrameWriter:
 
     # ------------------------------------------------------------------ files
     def _write_vtu(self, path: Path, mesh, field: dict) -> None:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".vtu", dir=self.directory)
-        os.close(fd)
-        try:
+        with atomic_path(path, suffix=".vtu") as tmp:
             self._meshio.write(tmp, mesh, file_format="vtu")
             with open(tmp, encoding="utf-8") as fh:
                 text = fh.read()
@@ -166,14 +162,6 @@ class FrameWriter:
             text = text.replace("<UnstructuredGrid>", "<UnstructuredGrid>\n" + _field_data_xml(field), 1)
             with open(tmp, "w", encoding="utf-8") as fh:
                 fh.write(text)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.chmod(tmp, 0o644)
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
 
     def _write_collection(self) -> None:
         root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")

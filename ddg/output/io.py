@@ -1,6 +1,7 @@
 """The output contract: DIR/path.csv and DIR/summary.json, written atomically."""
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -15,15 +16,19 @@ from ..geometry.strip import InputError
 from ..analysis.observables import EXTRA_COLUMNS, PATH_COLUMNS
 
 
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write text to path via a temporary file in the same folder and os.replace."""
+@contextlib.contextmanager
+def atomic_path(path: Path, suffix: str = ""):
+    """A temporary file name in path's folder to write to; on success it is synced, made 0644
+    and moved onto path with os.replace (readers see the old file or the whole new one, never a
+    part); on any exception, Ctrl-C included, it is removed and path is left as it was. The one
+    atomic writer of the project: atomic_write_text, the VTU frames and the rendered images use it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    os.close(fd)
     try:
-        with os.fdopen(fd, "w", newline="") as fh:
-            fh.write(text)
-            fh.flush()
+        yield tmp
+        with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o644)  # mkstemp creates 0600
         os.replace(tmp, path)
@@ -31,6 +36,13 @@ def atomic_write_text(path: Path, text: str) -> None:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write text to path atomically (atomic_path)."""
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", newline="") as fh:
+            fh.write(text)
 
 
 def _format(value):

@@ -1,3 +1,4 @@
+"""`python -m ddg`: the command line (ddg.cli)."""
 import sys
 
 from .cli import main

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .curvatures import _plate_points, framed_curve_curvatures, plate_centerline_frame
+from .curvatures import plate_points, framed_curve_curvatures, plate_centerline_frame
 from ..geometry.frames import cross, unit
 from ..geometry.strip import InputError, Strip
 
@@ -88,7 +88,7 @@ def edge_reconstruction(model, q: np.ndarray) -> dict:
     m2 = frame["m2_node"][inner][keep]
     t = frame["t_node"][inner][keep]
     eta = (frame["tau"][inner] / frame["kappa2"][inner])[keep]
-    plate_edge = _plate_points(model, q, s, np.full_like(s, -0.5 * W))
+    plate_edge = plate_points(model, q, s, np.full_like(s, -0.5 * W))
     rod_edge = centre + 0.5 * W * m2
     ribbon_edge = centre + 0.5 * W * (eta[:, None] * t + m2)
     rod_err = np.linalg.norm(rod_edge - plate_edge, axis=1) / L

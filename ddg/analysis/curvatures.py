@@ -74,7 +74,7 @@ def plate_centerline_frame(model, q: np.ndarray, stations):
     hinges the line crosses), made normal to the edge. Returns x, m1, s / L."""
     L = model.strip.length
     s = np.linspace(0.0, L, stations) if np.ndim(stations) == 0 else np.asarray(stations, dtype=float)
-    x = _plate_points(model, q, s, np.zeros_like(s))
+    x = plate_points(model, q, s, np.zeros_like(s))
     mid = 0.5 * (s[1:] + s[:-1])
     nodes, weights = model.mesh.interpolation_matrix(np.stack([mid, np.zeros_like(mid)], axis=1))
     normals = np.einsum("qk,qkc->qc", weights, plate_vertex_normals(model, q)[nodes])
@@ -83,7 +83,7 @@ def plate_centerline_frame(model, q: np.ndarray, stations):
     return x, m1, s / L
 
 
-def _plate_points(model, q, s, y):
+def plate_points(model, q, s, y):
     """Deformed positions of the material points with rest coordinates (s, y)."""
     nodes, weights = model.mesh.interpolation_matrix(np.stack([s, y], axis=1))
     return np.einsum("qk,qkc->qc", weights, model.positions(q)[nodes])

@@ -18,6 +18,7 @@ from ..geometry.strip import LoadingProtocol, Strip
 from ..output.interrupts import signal_name_of
 from ..output.io import (STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED, write_centerline_csv, write_path_csv,
                          write_summary_json)
+from ..version import __version__
 
 
 @dataclass
@@ -70,8 +71,6 @@ class DynamicResult(SimulationResult):
 
 
 def versions() -> dict:
-    from .. import __version__
-
     return {"ddg": __version__, "python": platform.python_version(), "numpy": np.__version__,
             "scipy": scipy.__version__}
 

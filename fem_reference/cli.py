@@ -14,6 +14,8 @@ import json
 import os
 import sys
 
+from .scene import add_scene_options, scene_from_args
+
 EXIT_FAILURE = 1
 EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
@@ -23,32 +25,6 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, exit 2, no usage dump (as ddg.cli)
         sys.stderr.write(f"error: {' '.join(str(message).split())}\n")
         raise SystemExit(EXIT_BAD_INPUT)
-
-
-def _add_scene(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--width-ratio", type=float, required=True, help="W/L in (0, 1]")
-    p.add_argument("--compression-ratio", type=float, required=True, help="dL/L in [0.001, 0.9]")
-    p.add_argument("--shear-ratio", type=float, default=None, help="largest dW/L (default dW_max/L, Eq. B.1)")
-    p.add_argument("--slenderness", type=float, default=None, help="L/b in [10, 1e5] (default b = 0.127 mm)")
-    p.add_argument("--poisson-ratio", type=float, default=0.0, help="nu in [0, 0.5) (default 0)")
-    p.add_argument("--compression-steps", type=int, default=40, help="recorded compression steps, 1..5000 (default 40)")
-    p.add_argument("--shear-steps", type=int, default=120, help="recorded shear steps, 1..5000 (default 120)")
-    p.add_argument("--shear-sign", type=int, default=1, choices=(1, -1))
-
-
-def _scene(args):
-    """Strip and LoadingProtocol of the scene options (ddg validates them: one-line InputError)."""
-    from ddg.geometry.strip import LoadingProtocol, Strip
-    from ddg.limits import check_steps
-
-    check_steps("--compression-steps", args.compression_steps)
-    check_steps("--shear-steps", args.shear_steps)
-    strip = Strip.from_ratios(args.width_ratio, args.compression_ratio, args.slenderness,
-                              poisson_ratio=args.poisson_ratio)
-    protocol = LoadingProtocol(args.compression_ratio, args.shear_ratio, args.compression_steps,
-                               args.shear_steps, args.shear_sign)
-    protocol.resolved_shear_ratio(strip)
-    return strip, protocol
 
 
 #: Option names of the command line, for api.check_inputs' messages.
@@ -64,7 +40,7 @@ def _thresholds_note(s: dict) -> str:
 def cmd_simulate(args) -> int:
     from .api import check_inputs
 
-    strip, protocol = _scene(args)
+    strip, protocol = scene_from_args(args)
     # every input checked before dolfinx is imported (api.simulate checks them again, cheaply)
     check_inputs(strip, protocol, args.resolution, args.across, args.material, args.out, args.perturbation,
                  names=OPTION_NAMES)
@@ -110,7 +86,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m fem_reference", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     p = sub.add_parser("simulate", help="one run: path.csv, summary.json, centerline.csv, fields.xdmf")
-    _add_scene(p)
+    add_scene_options(p)
     p.add_argument("--resolution", type=int, default=60,
                    help="elements along L, 4..400, odd rounded up to even (default 60)")
     p.add_argument("--across", type=int, default=None,
@@ -127,7 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_simulate)
     p = sub.add_parser("convergence", help="2-6 meshes, Richardson extrapolation, CSV + markdown table")
-    _add_scene(p)
+    add_scene_options(p)
     p.add_argument("--resolutions", type=int, nargs="+", default=[60, 90, 120],
                    help="elements along L of each mesh, 4..400 each (default 60 90 120)")
     p.add_argument("--out", required=True)

@@ -82,9 +82,9 @@ def run_convergence(args) -> int:
     from ddg.output.io import check_output_directory
 
     from .api import check_inputs, simulate
-    from .cli import _scene
+    from .scene import scene_from_args
 
-    strip, protocol = _scene(args)
+    strip, protocol = scene_from_args(args)
     resolutions = check_resolutions(args.resolutions, strip.width_ratio)
     out = check_output_directory(args.out, "--out")
     for n in resolutions:  # every run's inputs and folder checked before the first is computed

@@ -22,6 +22,7 @@ from .protocol.progress import ProgressBar
 from .protocol.results import DynamicResult, RibbonResult, SimulationResult, base_summary
 from .protocol.steppers import ImplicitEulerStepper, RodDrivenStepper, StaticStepper, dynamic_loading
 from .solve.continuation import ContinuationOptions
+from .solve.probe import SILENT, Probe
 
 __all__ = ["simulate", "run_ribbon", "simulate_dynamic", "make_model", "SimulationResult", "RibbonResult",
            "DynamicResult"]
@@ -182,6 +183,7 @@ def simulate(
     frames: bool = False,
     thresholds: bool = True,
     branches: bool | None = None,
+    probe: Probe | None = None,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
@@ -206,7 +208,8 @@ def simulate(
     branch of the shear stage by pseudo-arclength continuation, stable and unstable parts, through folds (U, US+, US-, and
     S from the first S state of the path; ddg.solve.branches): rows in result.branch_rows and
     out/branches.csv (path.csv's columns after a `branch` column), per-branch summary under
-    the summary key `branches`.
+    the summary key `branches`. probe: a ddg.solve.probe.Probe told of every Newton solve of the
+    path and every recorded step with its wall time (benchmarks, progress displays).
     """
     _checked_scene(strip, protocol)
     if not isinstance(solver, str) or solver not in ("static", "dynamic"):
@@ -215,6 +218,8 @@ def simulate(
     if options is not None and not isinstance(options, ContinuationOptions):
         raise InputError(f"options = {options!r} must be a ddg.ContinuationOptions")
     _checked_flags(progress=progress, frames=frames, thresholds=thresholds)
+    if probe is not None and not isinstance(probe, Probe):
+        raise InputError(f"probe = {probe!r} must be a ddg.solve.probe.Probe")
     if branches is not None and not isinstance(branches, (bool, np.bool_)):
         raise InputError(f"branches = {branches!r} must be True, False or None")
     resolution = check_resolution(model, resolution, strip, mesh)
@@ -237,11 +242,11 @@ def simulate(
         raise InputError("frames=True needs an output directory (out)")
     options = _checked_options(options)
     return _static_run(model, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,
-                       frames=frames)
+                       frames=frames, probe=probe)
 
 
 def _static_run(name, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,
-                frames=False, summary_extra=None, stepper=None, result=SimulationResult):
+                frames=False, summary_extra=None, stepper=None, result=SimulationResult, probe=None):
     """A static run of `instance` (or of `stepper`'s model) through the driver: the rows,
     the thresholds from the model's own stability, the branches (if asked)."""
     loading = Loading.equally_spaced(strip, protocol)
@@ -251,7 +256,7 @@ def _static_run(name, instance, strip, protocol, resolution, options, out, progr
     writer = _frame_writer(instance, Path(out) / "frames") if frames else None
     bar = ProgressBar(len(loading.compression) + len(loading.shear) + 1, progress)
     listeners, centerlines = _recorders(instance, folder, bar, writer)
-    stepper = stepper or StaticStepper(instance, options)
+    stepper = stepper or StaticStepper(instance, options, probe=probe)
     after, on_compressed, branch_step = [], [], None
     extra_rows = {}
     if isinstance(stepper, RodDrivenStepper):
@@ -288,19 +293,21 @@ def _static_run(name, instance, strip, protocol, resolution, options, out, progr
 
     closers = [bar.close] + ([writer.close] if writer is not None else [])
     run = Run(stepper, loading, lambda stage, state: observe(instance, state, stage, options.eigenvalues), summary,
-              listeners, folder, [AfterStep(step.stage, step.run, step.checkpoint) for step in after], compressed, make_result, closers)
+              listeners, folder, [AfterStep(step.stage, step.run, step.checkpoint) for step in after], compressed,
+              make_result, closers, probe or SILENT)
     return execute(run)
 
 
 def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", zeta: float | None = None,
                resolution: int | None = None, out=None, options: ContinuationOptions | None = None,
-               thresholds: bool = True, progress: bool = False) -> RibbonResult:
+               thresholds: bool = True, progress: bool = False, probe: Probe | None = None) -> RibbonResult:
     """The ribbon (Eq. A.5) through the two-stage protocol, started "direct" or from the "rod".
 
     Rows, summary and centerlines as ddg.simulate (path.csv, summary.json, centerline.csv);
     summary adds ribbon_init, zeta, zeta_over_L. init="direct" locates dW1 from the ribbon's own
     stability where its path leaves U (None if it never does); init="rod" reports the rod's
     thresholds as rod_dW1_over_L, rod_dW2_over_L and writes the rod's rows to rod_path.csv.
+    probe: as in simulate (for init="rod", the rod's solves).
     """
     from .models.ribbon import RibbonModel
     from .models.rod import RodModel
@@ -316,12 +323,12 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
         check_output_directory(out)
     options = _checked_options(options)
     ribbon = RibbonModel(strip, resolution, zeta=zeta)
-    stepper = RodDrivenStepper(ribbon, RodModel(strip, resolution), options) if init == "rod" \
-        else StaticStepper(ribbon, options, folds=False)
+    stepper = RodDrivenStepper(ribbon, RodModel(strip, resolution), options, probe) if init == "rod" \
+        else StaticStepper(ribbon, options, folds=False, probe=probe)
     L = strip.length
     return _static_run("ribbon", ribbon, strip, protocol, resolution, options, out, progress, thresholds, False,
                        summary_extra={"ribbon_init": init, "zeta": ribbon.zeta, "zeta_over_L": ribbon.zeta / L},
-                       stepper=stepper, result=RibbonResult)
+                       stepper=stepper, result=RibbonResult, probe=probe)
 
 
 def simulate_dynamic(strip: Strip, protocol: LoadingProtocol, resolution: int = 100, options=None,

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Protocol, Sequence
 
 from ..geometry.strip import LoadingProtocol, Strip
+from ..solve.probe import SILENT, Probe
 from .results import SimulationResult, finish_summary
 
 
@@ -107,12 +108,14 @@ class Run:
     on_compressed: Callable[[PathOutcome], None] | None = None
     make_result: Callable[[PathOutcome], SimulationResult] | None = None
     close: Sequence[Callable[[], None]] = ()                 # writers and progress bars to close
+    probe: Probe = SILENT                                    # told of every recorded step and its wall time
 
 
 def follow(run: Run) -> PathOutcome:
     """Walk the recorded loads: rest, compression, shear; never raises for a failed step or an
     interrupt (they end the walk and are kept in the outcome)."""
     stepper, out = run.stepper, PathOutcome()
+    clock = [time.perf_counter()]
 
     def record(stage: str, state) -> None:
         row = run.observe(stage, state)
@@ -120,6 +123,9 @@ def follow(run: Run) -> PathOutcome:
         out.state = state
         for listener in run.listeners:
             listener(stage, state, row)
+        now = time.perf_counter()
+        run.probe.step(stage, row, now - clock[0])
+        clock[0] = now
 
     try:
         state = stepper.rest()

@@ -27,10 +27,10 @@ class StaticStepper:
 
     failure = ContinuationFailure
 
-    def __init__(self, model, options: ContinuationOptions, folds: bool = True):
+    def __init__(self, model, options: ContinuationOptions, folds: bool = True, probe=None):
         self.model = model
         self.options = options
-        self.follower = PathFollower(model, options)
+        self.follower = PathFollower(model, options, probe)
         self.report_folds = folds
 
     def rest(self) -> State:
@@ -59,11 +59,11 @@ class RodDrivenStepper:
 
     failure = ContinuationFailure
 
-    def __init__(self, ribbon, rod, options: ContinuationOptions):
+    def __init__(self, ribbon, rod, options: ContinuationOptions, probe=None):
         self.model = ribbon
         self.rod = rod
         self.options = options
-        self.inner = StaticStepper(rod, options, folds=False)
+        self.inner = StaticStepper(rod, options, folds=False, probe=probe)
         self.driven: State | None = None
         self.relax_iterations = 0
 

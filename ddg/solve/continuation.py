@@ -17,6 +17,7 @@ import numpy as np
 
 from ..geometry.strip import InputError
 from .arclength import ArclengthOptions, ArclengthTracer
+from .probe import SILENT, Probe
 from .newton import ROUNDOFF_STALL_FACTOR, NewtonOptions, check_option, newton
 from .stability import lowest_modes
 from .state import State, asymmetry, crosses, phase_of
@@ -72,9 +73,10 @@ class ContinuationOptions:
 
 
 class PathFollower:
-    def __init__(self, model, options: ContinuationOptions | None = None):
+    def __init__(self, model, options: ContinuationOptions | None = None, probe: Probe | None = None):
         self.model = model
         self.options = options or ContinuationOptions()
+        self.probe = probe or SILENT  # told of every Newton solve (ddg.solve.probe)
         self.substep = 1.0
         self.newton_iterations = 0
         self._easy_streak = 0
@@ -90,9 +92,10 @@ class PathFollower:
         newton_iterations_by_phase)."""
         return {**self.iterations_by_phase, "line search trials": self.line_search_trials}
 
-    def _spent(self, iterations: int, phase: str) -> None:
+    def _spent(self, iterations: int, phase: str, converged: bool = True) -> None:
         self.newton_iterations += iterations
         self.iterations_by_phase[phase] += iterations
+        self.probe.solve(phase, iterations, converged)
 
     # ------------------------------------------------------------------ predictors
     def remember(self, state: State, restart: bool = False) -> None:
@@ -146,7 +149,7 @@ class PathFollower:
             q = model.apply_clamps(model.buckled_guess(compression, direction), compression, 0.0)
             model.commit(q)
             result = newton(model, q, self.options.newton, minimize=True)
-            self._spent(result.iterations, "compression start")
+            self._spent(result.iterations, "compression start", result.converged)
             if result.converged:
                 state = State(result.q, result.evaluation, compression, 0.0, bool(result.positive_definite),
                               result.iterations)
@@ -240,7 +243,7 @@ class PathFollower:
             q = extrapolated
             q[model.constrained] = new_clamps
             result = newton(model, q, opts)
-            self._spent(result.iterations, "accepted steps" if result.converged else "rejected steps")
+            self._spent(result.iterations, "accepted steps" if result.converged else "rejected steps", result.converged)
             self.line_search_trials += result.line_search_trials
             if not result.converged:
                 model.restore_frames(saved)
@@ -252,7 +255,7 @@ class PathFollower:
             q[model.constrained] = new_clamps
             q[model.free] -= K.solve(model.coupling(state.evaluation.hessian, dq_c))
             result = newton(model, q, opts)
-            self._spent(result.iterations, "accepted steps" if result.converged else "rejected steps")
+            self._spent(result.iterations, "accepted steps" if result.converged else "rejected steps", result.converged)
             self.line_search_trials += result.line_search_trials
         if result is None or not result.converged:
             model.restore_frames(saved)
@@ -285,7 +288,7 @@ class PathFollower:
             q = (1 - weight) * before.q + weight * after.q
             q[model.constrained] = model.clamp_values(compression, shear)
             result = newton(model, q, self.options.newton)
-            self._spent(result.iterations, "fold snaps")
+            self._spent(result.iterations, "fold snaps", result.converged)
             if result.converged:
                 new = State(result.q, result.evaluation, compression, shear, bool(result.positive_definite),
                             result.iterations + tracer.newton_iterations)
@@ -341,7 +344,7 @@ class PathFollower:
             model.restore_frames(junction.frames)
             q[model.constrained] = model.clamp_values(compression, between)
             result = newton(model, q, self.options.newton)
-            self._spent(result.iterations, "fold snaps")
+            self._spent(result.iterations, "fold snaps", result.converged)
             if not result.converged or phase_of(model, State(result.q, None, compression, between, False)).startswith("US"):
                 return None
             model.commit(result.q, result.evaluation)
@@ -366,7 +369,7 @@ class PathFollower:
         q = model.apply_clamps(state.q, compression, shear)
         model.commit(q)
         result = newton(model, q, self.options.newton, minimize=True)
-        self._spent(result.iterations, "fold snaps")
+        self._spent(result.iterations, "fold snaps", result.converged)
         if result.converged and result.positive_definite:
             return State(result.q, result.evaluation, compression, shear, True, result.iterations, branch_switched=True)
         model.restore_frames(saved)
@@ -402,7 +405,7 @@ class PathFollower:
             q = state.q + sign * kick * self._length * mode
             model.commit(q)
             result = newton(model, q, self.options.newton, minimize=True)
-            self._spent(result.iterations, "branch switching")
+            self._spent(result.iterations, "branch switching", result.converged)
             if result.converged and result.positive_definite:
                 return State(result.q, result.evaluation, state.compression, state.shear, True,
                              state.iterations + result.iterations, branch_switched=True)
@@ -510,7 +513,7 @@ class PathFollower:
                 nearest = lo if abs(lo[2]) <= abs(hi[2]) else hi
                 model.restore_frames(nearest[3])
                 result = newton(model, nearest[1], self.options.newton, evaluation=nearest[4])
-                self._spent(result.iterations, "branch switching")
+                self._spent(result.iterations, "branch switching", result.converged)
                 if result.converged and result.positive_definite:
                     return State(result.q, result.evaluation, unstable.compression, unstable.shear, True,
                                  unstable.iterations + result.iterations, branch_switched=True)

@@ -463,7 +463,8 @@ def draw(frames_and_titles, *, columns: int | None = None, window_size=None, col
          fit_to=None, clim=None, show_edges: bool = False) -> np.ndarray:
     """RGB image (H, W, 3) of one or more states in a grid of `columns` panels, each with its title,
     all seen by the same fixed camera fitted to all of them (or to `fit_to`: (K, 3) points or (6,)
-    bounds, units of L), colours on one scale (`clim`, default the range over all panels)."""
+    bounds, units of L), colours on one scale (`clim`, default the range over all panels). A panel
+    whose frame is None stays empty (keeps the grid's rows aligned)."""
     pv = import_pyvista()
     panels = list(frames_and_titles)
     count = len(panels)
@@ -471,7 +472,9 @@ def draw(frames_and_titles, *, columns: int | None = None, window_size=None, col
     rows = math.ceil(count / columns)
     if window_size is None:
         window_size = (WINDOW_SIZE[0], WINDOW_SIZE[1]) if count == 1 else (560 * columns, 420 * rows)
-    frames = [f for f, _ in panels]
+    frames = [f for f, _ in panels if f is not None]
+    if not frames:
+        raise InputError("nothing to draw: every panel is empty")
     fit = np.vstack([extent_points(f) for f in frames]) if fit_to is None else _as_fit_points(fit_to)
     pad = max(0.5 * (f.width or ROD_DIAMETER_DEFAULT) if f.kind == "rod" else 0.0 for f in frames)
     clim = _clim(frames, color_by) if clim is None else clim
@@ -479,10 +482,12 @@ def draw(frames_and_titles, *, columns: int | None = None, window_size=None, col
                          lighting="three lights")
     plotter.set_background(BACKGROUND)
     aspect = (window_size[0] / columns) / (window_size[1] / rows)
+    last = max(k for k, (frame, _) in enumerate(panels) if frame is not None)
     for k, (frame, title) in enumerate(panels):
+        if frame is None:
+            continue
         plotter.subplot(k // columns, k % columns)
-        _add_state(plotter, frame, color_by=color_by, clim=clim, show_edges=show_edges,
-                   scalar_bar=(k == count - 1))
+        _add_state(plotter, frame, color_by=color_by, clim=clim, show_edges=show_edges, scalar_bar=(k == last))
         plotter.add_text(title, position="upper_left", font_size=11 if count > 1 else 13, color=FOREGROUND)
         plotter.add_axes(color=FOREGROUND, line_width=2, labels_off=False)
         _fit_camera(plotter.renderer, fit, aspect, pad)
@@ -519,15 +524,20 @@ def render_frame(vtu_path, png_path, *, phase: str | None = None, title: str | N
 
 def render_grid(panels, png_path=None, *, columns: int | None = None, color_by: str = "z",
                 strip_widths=None, window_size=None, show_edges: bool = False):
-    """Several frames in one picture, one camera and one colour scale: panels are (vtu_path, title)
-    pairs (title None: the default title). Writes `png_path` and returns its path, or returns the
-    RGB image (H, W, 3) when png_path is None."""
+    """Several frames in one picture, filled row by row, `columns` wide, one camera and one colour
+    scale: panels are (vtu_path, title) pairs (title None: the default title) or None for an empty
+    panel. strip_widths (metres, per panel) size a rod's tube; a plate's comes from its frame.
+    Writes `png_path` and returns its path, or returns the RGB image (H, W, 3) when png_path is None."""
     pairs = list(panels)
     if not pairs:
         raise InputError("render_grid needs at least one (vtu_path, title) panel")
     widths = list(strip_widths) if strip_widths is not None else [None] * len(pairs)
     loaded = []
-    for (path, title), width in zip(pairs, widths):
+    for pair, width in zip(pairs, widths):
+        if pair is None:
+            loaded.append((None, ""))
+            continue
+        path, title = pair
         frame = read_frame(path, strip_width=width)
         loaded.append((frame, title if title is not None else title_of(frame)))
     image = draw(loaded, columns=columns, window_size=window_size, color_by=color_by, show_edges=show_edges)

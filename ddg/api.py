@@ -205,11 +205,12 @@ def simulate(
     value and the reason under `unresolved_thresholds` and in `warnings`.
     branches=True (with thresholds; default None: True for the rod, False for the plate, whose
     diagram costs more than its path, 440 s against 265 s at 2000 triangles) then traces every
-    branch of the shear stage by pseudo-arclength continuation, stable and unstable parts, through folds (U, US+, US-, and
-    S from the first S state of the path; ddg.solve.branches): rows in result.branch_rows and
-    out/branches.csv (path.csv's columns after a `branch` column), per-branch summary under
-    the summary key `branches`. probe: a ddg.solve.probe.Probe told of every Newton solve of the
-    path and every recorded step with its wall time (benchmarks, progress displays).
+    branch of the shear stage by pseudo-arclength continuation, stable and unstable parts,
+    through folds (U, US+, US-, and S from the first S state of the path; ddg.solve.branches):
+    rows in result.branch_rows and out/branches.csv (path.csv's columns after a `branch`
+    column), per-branch summary under the summary key `branches`.
+    probe: a ddg.solve.probe.Probe told of every Newton solve of the path and every recorded
+    step with its wall time (benchmarks, progress displays).
     """
     _checked_scene(strip, protocol)
     if not isinstance(solver, str) or solver not in ("static", "dynamic"):

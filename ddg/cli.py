@@ -49,7 +49,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="plate: a mesh file meshio reads (e.g. gmsh .msh) spanning L + 2c by W, or 'gmsh' for an "
                           "unstructured gmsh mesh of --resolution triangles (default: structured near-equilateral)")
     sim.add_argument("--frames", action="store_true",
-                     help="also write OUT/frames/frame_NNNNN.vtu per recorded step and OUT/frames/frames.pvd (ParaView)")
+                     help="also write OUT/frames/frame_NNNNN.vtu per recorded step and OUT/frames/frames.pvd "
+                          "(ParaView)")
     sim.add_argument("--compression-steps", type=int, default=40, help="recorded compression steps (default 40)")
     sim.add_argument("--shear-steps", type=int, default=120, help="recorded shear steps (default 120)")
     sim.add_argument("--shear-direction", type=int, choices=(1, -1), default=1, help="+1 or -1 (default +1)")
@@ -67,13 +68,15 @@ def build_parser() -> argparse.ArgumentParser:
                      help="stay on the branch the path starts on, even where it is unstable")
     sim.add_argument("--solver", choices=("static", "dynamic"), default="static",
                      help="static Newton continuation (default) or the paper's implicit-Euler time marching (rod)")
-    sim.add_argument("--clamp-speed", type=float, default=None, help="dynamic solver: clamp speed in m/s (default 1e-3)")
+    sim.add_argument("--clamp-speed", type=float, default=None,
+                     help="dynamic solver: clamp speed in m/s (default 1e-3)")
     sim.add_argument("--max-newton-iterations", type=int, default=15, help="per load step (default 15)")
     sim.add_argument("--out", default="out", help="output directory (default ./out)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar or result print-out")
 
     cur = sub.add_parser("curvatures", help="centerline curvatures k1, k2, tau along s (Figs. A.12-A.14): CSV and PNG")
-    cur.add_argument("--model", default="rod", choices=("rod", "plate", "ribbon"), help="rod (default), plate or ribbon")
+    cur.add_argument("--model", default="rod", choices=("rod", "plate", "ribbon"),
+                     help="rod (default), plate or ribbon")
     cur.add_argument("--width-ratio", type=float, default=0.05, help="W/L (default 0.05)")
     cur.add_argument("--compression-ratio", type=float, default=0.5, help="dL/L (default 0.5)")
     cur.add_argument("--shear-ratios", default="0,0.3,0.45", help="comma-separated dW/L to report (default 0,0.3,0.45)")
@@ -81,7 +84,8 @@ def build_parser() -> argparse.ArgumentParser:
     cur.add_argument("--resolution", type=int, default=None,
                      help="rod/ribbon: node count (default 100 / 101); plate: target triangles (default 2000)")
     cur.add_argument("--zeta", type=float, default=None, help="ribbon: zeta of Eq. (A.5) in metres (default 1e4 L)")
-    cur.add_argument("--ribbon-init", choices=("direct", "rod"), default="direct", help="ribbon: direct (default) or rod")
+    cur.add_argument("--ribbon-init", choices=("direct", "rod"), default="direct",
+                     help="ribbon: direct (default) or rod")
     cur.add_argument("--stations", type=int, default=None, help="plate: centerline stations (default ~ columns / 2)")
     cur.add_argument("--out", default="out", help="output directory: curvatures.csv, curvatures.png (default ./out)")
 
@@ -100,7 +104,8 @@ def build_parser() -> argparse.ArgumentParser:
     from .sweep import command as sweep_command
 
     sweep_command.add_arguments(sub.add_parser(
-        "sweep", help="a grid of runs (W/L, dL/L, L/b, resolution, model) as Dask tasks: one table and a phase diagram"))
+        "sweep",
+        help="a grid of runs (W/L, dL/L, L/b, resolution, model) as Dask tasks: one table and a phase diagram"))
     render_command.add_arguments(sub.add_parser("render", help="draw a run's frames (PNG, HTML scene) with pyvista"))
     return parser
 
@@ -148,7 +153,8 @@ def _require_extra(module: str, extra: str) -> None:
     import importlib.util
 
     if importlib.util.find_spec(module) is None:
-        raise InputError(f"this command needs {module}: pip install 'ddg-strips[{extra}]' (or Debian's python3-{module})")
+        raise InputError(f"this command needs {module}: pip install 'ddg-strips[{extra}]' (or Debian's "
+                         f"python3-{module})")
 
 
 def cmd_curvatures(args) -> int:
@@ -200,7 +206,8 @@ def cmd_curvatures(args) -> int:
     fig.savefig(out / "curvatures.png", dpi=120)
     plt.close(fig)
     for rec in records:
-        jumps = ", ".join(f"s/L={j['s_over_L']:.3f}: k2 jump x{j['k2_jump_ratio']:.3g}, tau L={j['tau_at_inflection_L']:.3g}"
+        jumps = ", ".join(f"s/L={j['s_over_L']:.3f}: k2 jump x{j['k2_jump_ratio']:.3g}, tau "
+                          f"L={j['tau_at_inflection_L']:.3g}"
                           for j in rec["inflections"])
         print(f"dW/L = {rec['dW_over_L']:.4g}: inflections {jumps or 'none'}")
     print(f"wrote {out / 'curvatures.csv'} and {out / 'curvatures.png'}")
@@ -249,7 +256,8 @@ def cmd_centerline_error(args) -> int:
     fig.savefig(out / "centerline_error.png", dpi=120)
     plt.close(fig)
     for r in rows:
-        print(f"L/W = {r['L_over_W']:.3g}  dW/L = {r['dW_over_L']:.3g}  mean {r['mean_error']:.3e}  max {r['max_error']:.3e}"
+        print(f"L/W = {r['L_over_W']:.3g}  dW/L = {r['dW_over_L']:.3g}  mean {r['mean_error']:.3e}  max "
+              f"{r['max_error']:.3e}"
               f"  {r['phase']} {r['message']}")
     print(f"wrote {out / 'centerline_error.csv'} and {out / 'centerline_error.png'}")
     failed = [r for r in rows if r["message"]]

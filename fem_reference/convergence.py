@@ -185,7 +185,10 @@ def summarise(runs, resolutions):
     n_common = len(grid)
     dw = np.array([row["dW_over_L"] for row in grid])
     H = np.array([np.interp(dw, *c) for c in curves])
-    phases = [[s[int(np.argmin(np.abs(np.array([r["dW_over_L"] for r in s]) - x)))]["phase"] for x in dw] for s in shear]
+    def phase_nearest(rows, x):
+        return rows[int(np.argmin(np.abs(np.array([r["dW_over_L"] for r in rows]) - x)))]["phase"]
+
+    phases = [[phase_nearest(s, x) for x in dw] for s in shear]
     compressed = np.array([[run.summary["H_mid_over_L_compressed"]] for run in runs])
     H_ext, p = extrapolate(H, resolutions) if len(runs) >= 2 else (H[-1], np.full(n_common, np.nan))
     Hc_ext, pc = extrapolate(compressed, resolutions) if len(runs) >= 2 else (compressed[-1], [np.nan])
@@ -214,7 +217,8 @@ def summarise(runs, resolutions):
             "dW2_over_L": dw2[i],
             "dW2_error": abs(dw2[i] - float(dw2_ext[0])),
             "H_max_error": float(np.nanmax(np.abs(H[i] - H_ext))),
-            "H_max_error_away": float(np.nanmax(np.where(_away(dw, dw1_ext[0], dw2[-1]), np.abs(H[i] - H_ext), np.nan))),
+            "H_max_error_away": float(np.nanmax(np.where(_away(dw, dw1_ext[0], dw2[-1]), np.abs(H[i] - H_ext),
+                                                         np.nan))),
             "dW_reached_over_L": float(curves[i][0][-1]),
             "wall_time_path_s": s["wall_time_s"],
             "wall_time_per_step_s": s["wall_time_s"] / max(steps, 1),
@@ -264,7 +268,8 @@ def write_outputs(out: Path, rows, table, runs, resolutions, strip, protocol) ->
     for t in table[:-1]:
         lines.append(f"| {t['resolution']} | {t['triangles']} | {t['n_dof']} | {f(t['H_compressed'], '{:.6f}')} | "
                      f"{f(t['H_compressed_error'], '{:.1e}')} | {f(t['dW1_over_L'], '{:.4f}')} | "
-                     f"{f(t['dW1_error'], '{:.1e}')} | {f(t['dW2_over_L'], '{:.4f}')} | {f(t['dW2_error'], '{:.1e}')} | "
+                     f"{f(t['dW1_error'], '{:.1e}')} | {f(t['dW2_over_L'], '{:.4f}')} | {f(t['dW2_error'], '{:.1e}')} "
+                     f"| "
                      f"{f(t['dW_reached_over_L'], '{:.3f}')} | {f(t['H_max_error'], '{:.1e}')} | "
                      f"{f(t['H_max_error_away'], '{:.1e}')} | {f(t['wall_time_per_step_s'], '{:.2f}')} | "
                      f"{f(t['wall_time_path_s'], '{:.0f}')} | {t['newton_iterations']} |")

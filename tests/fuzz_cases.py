@@ -273,7 +273,8 @@ def valid_cases() -> list[Case]:
         ("ddg-curvatures-rod", "ddg", DDG_CURVATURES["rod"]), ("ddg-curvatures-plate", "ddg", DDG_CURVATURES["plate"]),
         ("ddg-curvatures-ribbon", "ddg", DDG_CURVATURES["ribbon"]),
         ("ddg-centerline-error", "ddg", DDG_CENTERLINE_ERROR),
-        ("fem-simulate", "fem", FEM_SIMULATE), ("fem-convergence", "fem", FEM_CONVERGENCE), ("fem-gold", "fem", FEM_GOLD),
+        ("fem-simulate", "fem", FEM_SIMULATE), ("fem-convergence", "fem", FEM_CONVERGENCE), ("fem-gold", "fem",
+                                                                                             FEM_GOLD),
     )]
     for label, model, extra in (
             ("width-ratio-1", "rod", ("--width-ratio=1",)), ("width-ratio-1", "plate", ("--width-ratio=1",)),
@@ -298,7 +299,8 @@ def valid_cases() -> list[Case]:
             ("dynamic-clamp-speed-0.02", "rod", ("--solver=dynamic", "--clamp-speed=0.02")),
             ("zeta-1", "ribbon", ("--zeta=1",)), ("ribbon-init-rod", "ribbon", ("--ribbon-init=rod",)),
             ("mesh-gmsh", "plate", ("--mesh=gmsh",)), ("frames", "plate", ("--frames",)),
-            ("out-new-nested", "rod", ("--out={tmp}/new/nested/dir",)), ("out-existing-dir", "rod", ("--out={tmp}/dir",)),
+            ("out-new-nested", "rod", ("--out={tmp}/new/nested/dir",)), ("out-existing-dir", "rod",
+                                                                         ("--out={tmp}/dir",)),
             ("out-relative", "rod", ("--out=relative-out",)),
     ):
         out.append(Case(f"valid-ddg-simulate-{model}-{label}", "ddg", ddg_simulate(model, *extra), label, ACCEPT))

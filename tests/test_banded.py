@@ -47,7 +47,8 @@ def test_scatter_sums_overlapping_blocks_into_the_band():
     rng = np.random.default_rng(5)
     band = np.zeros((bandwidth + 1) * n)
     dense = np.zeros((n, n))
-    for dofs in (np.array([0, 1, 2, 4, 5, 6, 7]), np.array([9, 3, 5, 8, 4, 6, 7]), np.array([14, 8, 10, 12, 13, 11, 9])):
+    for dofs in (np.array([0, 1, 2, 4, 5, 6, 7]), np.array([9, 3, 5, 8, 4, 6, 7]), np.array([14, 8, 10, 12, 13, 11,
+                                                                                             9])):
         block = rng.standard_normal((7, 7))
         block = block + block.T
         add_symmetric_block(band, n, dofs, block)

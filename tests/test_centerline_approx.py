@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 import ddg
-from ddg.analysis.centerline_approx import centerline_error_field, centerline_error_study, centerline_frame, edge_reconstruction
+from ddg.analysis.centerline_approx import (centerline_error_field, centerline_error_study, centerline_frame,
+                                            edge_reconstruction)
 from ddg.analysis.curvatures import states_at_shears
 from ddg.models.plate import PlateModel
 

@@ -10,7 +10,8 @@ from ddg.cli import main
 CONTRACT_COLUMNS = ["stage", "dL_over_L", "dW_over_L", "H_mid_over_L", "F_shear_norm", "energy", "lambda_min", "phase"]
 CONTRACT_KEYS = {"model", "scene", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
                  "newton_iterations", "wall_time_s", "converged", "versions"}
-SMALL_RUN = ["simulate", "--model", "rod", "--width-ratio", "0.05", "--compression-ratio", "0.5", "--shear-ratio", "0.1",
+SMALL_RUN = ["simulate", "--model", "rod", "--width-ratio", "0.05", "--compression-ratio", "0.5", "--shear-ratio",
+             "0.1",
              "--resolution", "20", "--compression-steps", "5", "--shear-steps", "4", "--quiet"]
 
 
@@ -125,7 +126,8 @@ def test_dynamic_solver_writes_the_same_contract(tmp_path):
 
 
 PLATE_RUN = ["simulate", "--model", "plate", "--width-ratio", "0.1667", "--compression-ratio", "0.5",
-             "--shear-ratio", "0.05", "--resolution", "200", "--compression-steps", "4", "--shear-steps", "2", "--quiet"]
+             "--shear-ratio", "0.05", "--resolution", "200", "--compression-steps", "4", "--shear-steps", "2",
+             "--quiet"]
 
 
 def test_plate_run_writes_the_same_contract_and_frames(tmp_path):

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 import ddg
-from ddg.analysis.curvatures import (CURVATURE_COLUMNS, centerline_curvatures, framed_curve_curvatures, inflection_jumps,
+from ddg.analysis.curvatures import (CURVATURE_COLUMNS, centerline_curvatures, framed_curve_curvatures,
+                                     inflection_jumps,
                             states_at_shears, write_curvatures_csv)
 from ddg.geometry.strip import InputError
 

@@ -51,7 +51,9 @@ def test_incremental_potential_derivatives_match_finite_differences():
         rod.energy + 0.5 / dt**2 * np.sum(pot.free_mass * (q - pot.q_prev - dt * pot.v_prev) ** 2)
         + 0.5 * c / dt * np.sum(pot.free_mass * (q - pot.q_prev) ** 2), rel=1e-12)
 
-    energy = lambda x: pot.evaluate(x, gradient=False, hessian=False).energy
+    def energy(x):
+        return pot.evaluate(x, gradient=False, hessian=False).energy
+
     H = ev.hessian.to_dense()
     e0 = energy(q)
     g_fd, h_diag = np.zeros(n), np.zeros(n)
@@ -72,7 +74,8 @@ def test_incremental_potential_derivatives_match_finite_differences():
         a, b = 1e-5 * u, 1e-5 * w
         form = (energy(q + a + b) - energy(q + a - b) - energy(q - a + b) + energy(q - a - b)) / (4 * 1e-10)
         exact = u @ H @ w
-        assert form == pytest.approx(exact, rel=1e-5, abs=1e-6 * np.abs(H).max() * np.linalg.norm(u) * np.linalg.norm(w))
+        assert form == pytest.approx(exact, rel=1e-5,
+                                     abs=1e-6 * np.abs(H).max() * np.linalg.norm(u) * np.linalg.norm(w))
 
 
 def test_equilibrium_stays_put_without_clamp_motion(static):

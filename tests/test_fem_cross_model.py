@@ -25,7 +25,8 @@ THRESHOLD_MARGIN = 0.02
 @pytest.fixture(scope="module")
 def fem_gold():
     if not (GOLD / "path.csv").exists():
-        pytest.skip(f"no FEM gold data in {GOLD} (python -m fem_reference gold --out data/fem_gold --only dL0.5_W0.1667)")
+        pytest.skip(f"no FEM gold data in {GOLD} (python -m fem_reference gold --out data/fem_gold --only "
+                    f"dL0.5_W0.1667)")
     summary = json.loads((GOLD / "summary.json").read_text())
     rows = [r for r in read_path_csv(GOLD / "path.csv") if r["stage"] == "shear"]
     dw = np.array([float(r["dW_over_L"]) for r in rows])

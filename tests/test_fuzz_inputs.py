@@ -336,7 +336,8 @@ def test_input(case: Case, tmp_path, monkeypatch, capfd):
             line = _exception_text(outcome["exception"])
         if case.expect == REFUSE:
             problem = cli_problem(outcome)
-        elif outcome["work"] and not [x for x in outcome["err"].splitlines() if x.strip() and not x.startswith("warning:")]:
+        elif outcome["work"] and not [x for x in outcome["err"].splitlines()
+                                      if x.strip() and not x.startswith("warning:")]:
             problem = None  # validation passed (a `warning:` line is allowed), the solver was reached
         elif outcome["work"]:
             problem = ("valid input: stderr not empty before the solver", line)
@@ -384,7 +385,8 @@ def test_bad_input_in_a_subprocess(case: Case, tmp_path, monkeypatch):
     """The real program: exit 2, one `error:` line on stderr, no traceback, within 30 s."""
     prepare(tmp_path, monkeypatch)
     module = "ddg" if case.prog == "ddg" else "fem_reference"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")]).rstrip(os.pathsep),
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH",
+                                                                                  "")]).rstrip(os.pathsep),
            "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MPLBACKEND": "Agg"}
     t0 = time.perf_counter()
     try:

@@ -444,7 +444,8 @@ def test_frame_writer_writes_vtu_frames_and_a_collection(tmp_path):
     written = []
     with FrameWriter(directory, mesh) as writer:
         for k in range(4):
-            positions = np.column_stack([mesh.nodes, np.zeros(mesh.node_count)]) + 1e-3 * rng.random((mesh.node_count, 3))
+            positions = np.column_stack([mesh.nodes, np.zeros(mesh.node_count)]) + 1e-3 * rng.random((mesh.node_count,
+                                                                                                      3))
             path = writer.write(positions, step=k, dL_over_L=0.5, dW_over_L=0.01 * k, stage="shear",
                                 point_data={"height": positions[:, 2]})
             written.append(positions)

@@ -64,8 +64,11 @@ def test_straight_strip_loses_stability_at_clamped_euler_loads():
     unit = ei / L**2 / ea  # strain at which P = EI / L^2
 
     def crossing(index):
-        f = lambda p: _straight_lowest_eigenvalues(rod, p * unit, index + 1)[index]
-        return brentq(f, 0.5 * [EULER_SYMMETRIC, EULER_ANTISYMMETRIC][index], 1.5 * [EULER_SYMMETRIC, EULER_ANTISYMMETRIC][index], xtol=1e-6)
+        def f(p):
+            return _straight_lowest_eigenvalues(rod, p * unit, index + 1)[index]
+
+        return brentq(f, 0.5 * [EULER_SYMMETRIC, EULER_ANTISYMMETRIC][index],
+                      1.5 * [EULER_SYMMETRIC, EULER_ANTISYMMETRIC][index], xtol=1e-6)
 
     # P = EA * strain exactly for the discrete straight rod. Measured -3.4e-4 and -6.3e-4 at M = 100
     # (the O(h^2) discretisation error; brentq's xtol 1e-6 is far below): bounds 4 times those

@@ -166,7 +166,8 @@ def states_at_shears(model_name: str, strip, compression_ratio: float, shear_rat
         raise InputError(f"shear ratios = {shear_ratios!r} must be a non-empty list of dW/L >= 0")
     limit = strip.shear_limit(compression_ratio * strip.length) / strip.length
     if shear_ratios[-1] > limit:
-        raise InputError(f"dW/L = {shear_ratios[-1]:g} beyond the shear limit {limit:.6g} (Eq. B.1); allowed [0, {limit:.6g}]")
+        raise InputError(f"dW/L = {shear_ratios[-1]:g} beyond the shear limit {limit:.6g} (Eq. B.1); allowed [0, "
+                         f"{limit:.6g}]")
     options = options or ContinuationOptions()
     L = strip.length
     relax = None
@@ -228,7 +229,12 @@ def inflection_twist_study(width_ratios=(1 / 20, 1 / 6), slendernesses=(300.0, 6
             rows.append({"W_over_L": ratio, "L_over_b": slenderness, "dW_over_L": shear_ratio,
                          "inflections": len(jumps), "tau_inflection_L": tau_infl, "tau_max_L": tau_max,
                          "tau_inflection_over_max": tau_infl / tau_max,
-                         "k2_jump_ratio": float(np.mean([j["k2_jump_ratio"] for j in jumps])) if jumps else float("nan"),
-                         "tau_jump_ratio": float(np.mean([j["tau_jump_ratio"] for j in jumps])) if jumps else float("nan"),
+                         "k2_jump_ratio": _mean_of(jumps, "k2_jump_ratio"),
+                         "tau_jump_ratio": _mean_of(jumps, "tau_jump_ratio"),
                          "triangles": model.mesh.triangle_count})
     return rows
+
+
+def _mean_of(rows: list[dict], key: str) -> float:
+    """Mean of rows[...][key]; NaN for no rows."""
+    return float(np.mean([r[key] for r in rows])) if rows else float("nan")

@@ -224,6 +224,7 @@ def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float
     row_u = observe(ribbon, rib_u, "shear")
     ribbon.restore_frames(frames_us)
     row_us = observe(ribbon, rib_us, "shear")
+    top = barrier["top"]
     return {
         "rod_dW1_over_L": dw1 / L,
         "rod_lambda_min_at_rod_dW1": lam(rod, rod_at),
@@ -236,9 +237,10 @@ def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float
                             "lambda_min": row_us["lambda_min"], "energy": rib_us.evaluation.energy / unit},
         "rod_H_mid_over_L_beyond": float(rod.midpoint(rod_us.q)[2]) / L,
         "straight_line_barrier": barrier["barrier"] / unit,
-        "straight_line_barrier_quartic_share": float(barrier["quartic"][barrier["top"]] / barrier["energy"][barrier["top"]])
-        if barrier["energy"][barrier["top"]] > 0 else float("nan"),
+        "straight_line_barrier_quartic_share": (float(barrier["quartic"][top] / barrier["energy"][top])
+                                                if barrier["energy"][top] > 0 else float("nan")),
         "barrier_peak_node_s_over_L": barrier["peak_node_s_over_L"],
-        **({} if drag is None else {"drag_barrier": drag["barrier"] / unit, "drag_barrier_quartic": drag["quartic_at_top"] / unit,
+        **({} if drag is None else {"drag_barrier": drag["barrier"] / unit,
+                                    "drag_barrier_quartic": drag["quartic_at_top"] / unit,
                                      "drag_barrier_at_t": drag["at_t"], "drag_worst_residual": drag["worst_residual"]}),
     }

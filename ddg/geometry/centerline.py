@@ -28,7 +28,8 @@ class Centerline:
 
     def __post_init__(self) -> None:
         if not isinstance(self.nodes, (int, np.integer)) or isinstance(self.nodes, bool):
-            raise InputError(f"resolution M = {self.nodes!r} is not an integer node count; allowed: an integer >= {MIN_NODES}")
+            raise InputError(f"resolution M = {self.nodes!r} is not an integer node count; allowed: an integer >= "
+                             f"{MIN_NODES}")
         if self.nodes < MIN_NODES:
             raise InputError(f"resolution M = {self.nodes!r} nodes is too small; allowed: an integer >= {MIN_NODES}")
 

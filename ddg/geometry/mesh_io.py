@@ -146,8 +146,9 @@ def gmsh_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANGLES,
     x = +-c and L -+ c of the clamped bands, so those are mesh lines; the bands are meshed
     structured and the plate centre (L/2, 0) is a node. The clamp depth c defaults to half the
     height of an equilateral triangle, sqrt(3)/4 h, so that, as on the structured mesh (half a
-    column spacing), each band is one layer of rigid triangles straddling its clamp line. Deterministic (fixed seed, one thread, no
-    config files); gmsh is initialised only if it is not already, and left as it was found.
+    column spacing), each band is one layer of rigid triangles straddling its clamp line.
+    Deterministic (fixed seed, one thread, no config files); gmsh is initialised only if it is
+    not already, and left as it was found.
     `triangles` is an integer in [16, MAX_TRIANGLES] whose plate run fits in memory
     (plate_mesh.check_plate_size), checked before gmsh is called. Note: a clamp_depth of more
     than one layer makes the clamped bands several layers deep; the last rigid layer then

@@ -47,7 +47,8 @@ def _finite_positive(name: str, value: float) -> float:
 
 
 def _within(name: str, value: float, low: float, high: float, unit: str, why: str) -> float:
-    _require(low <= value <= high, f"{name} = {value:g}{unit} outside the allowed range [{low:g}, {high:g}]{unit}; {why}")
+    _require(low <= value <= high,
+             f"{name} = {value:g}{unit} outside the allowed range [{low:g}, {high:g}]{unit}; {why}")
     return value
 
 
@@ -231,7 +232,8 @@ def _compression_ratio(value) -> float:
     value = _ratio("compression_ratio dL/L", value, 0.0, 1.0)
     low, high = COMPRESSION_RATIO_RANGE
     _require(low <= value <= high, f"compression_ratio dL/L = {value!r} outside the allowed range [{low:g}, {high:g}]: "
-             "below it the strip is barely buckled, above it the elastica closes on itself (self-contact, not modelled)")
+             "below it the strip is barely buckled, above it the elastica closes on itself "
+             "(self-contact, not modelled)")
     return value
 
 

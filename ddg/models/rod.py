@@ -44,7 +44,8 @@ class RodModel(BandedModel):
         self.rest_edge_lengths = np.full(m - 1, h)
         self.voronoi_lengths = 0.5 * (self.rest_edge_lengths[:-1] + self.rest_edge_lengths[1:])
         self.stretch_stiffness = strip.stretching_stiffness / self.rest_edge_lengths  # Eq. (6a)
-        self.constrained = np.r_[np.arange(CLAMPED_DOFS_PER_END), np.arange(self.n_dof - CLAMPED_DOFS_PER_END, self.n_dof)]
+        self.constrained = np.r_[np.arange(CLAMPED_DOFS_PER_END), np.arange(self.n_dof - CLAMPED_DOFS_PER_END,
+                                                                            self.n_dof)]
         self.free = slice(CLAMPED_DOFS_PER_END, self.n_dof - CLAMPED_DOFS_PER_END)
         self._edge_nodes = np.stack([np.arange(m - 1), np.arange(1, m)], axis=1)
         self.reset()
@@ -124,7 +125,10 @@ class RodModel(BandedModel):
         """Sign convention of a mode: +1 raises the midpoint (direction=1) or the first half
         of the strip against the second (direction=0, the '+' branches US+ and S+)."""
         z = mode[self.node_dofs][:, 2]
-        at = lambda frac: float(self.centerline.interpolate_at(z, frac * self.strip.length))
+
+        def at(frac):
+            return float(self.centerline.interpolate_at(z, frac * self.strip.length))
+
         return at(0.5) if direction else at(0.25) - at(0.75)
 
     def clamp_force(self, gradient: np.ndarray) -> np.ndarray:

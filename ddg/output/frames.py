@@ -71,7 +71,8 @@ class FrameWriter:
         else:
             cells = np.asarray(mesh_or_cells)
         if cells.ndim != 2 or len(cells) == 0 or not np.issubdtype(cells.dtype, np.integer):
-            raise InputError(f"cells have shape {cells.shape} and dtype {cells.dtype}; expected integer (C, 3) or (C, 2), C > 0")
+            raise InputError(f"cells have shape {cells.shape} and dtype {cells.dtype}; expected integer (C, 3) or (C, "
+                             f"2), C > 0")
         if cell_type is None:
             cell_type = {3: "triangle", 2: "line"}.get(cells.shape[1])
         if cell_type not in CELL_NODES:

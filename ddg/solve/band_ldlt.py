@@ -35,7 +35,8 @@ works on the transposed band t (n, b + 1), t[j, r] = A[j + r, j], so that each c
 update runs over contiguous memory; for b >= BLOCKED_FROM it eliminates PANEL columns at a time
 and applies their update to the band on their right as dense matrix products (np.dot, BLAS),
 gathered from and scattered back to t (the products also fill part of the upper triangle: about
-1.3 times the flops of the unblocked loop at bandwidth 240, most of them in BLAS). The compiled code is cached next to this module (__pycache__) by numba.
+1.3 times the flops of the unblocked loop at bandwidth 240, most of them in BLAS). The compiled
+code is cached next to this module (__pycache__) by numba.
 """
 from __future__ import annotations
 
@@ -159,9 +160,9 @@ def _solve_transposed(t, x):
     for j in range(n):  # L y = x (unit diagonal)
         m = min(u, n - 1 - j)
         for r in range(1, m + 1):
-            l = t[j, r]
+            lower = t[j, r]
             for c in range(k):
-                x[j + r, c] -= l * x[j, c]
+                x[j + r, c] -= lower * x[j, c]
     for j in range(n):  # D z = y
         inv = 1.0 / t[j, 0]
         for c in range(k):
@@ -169,9 +170,9 @@ def _solve_transposed(t, x):
     for j in range(n - 1, -1, -1):  # L^T x = z
         m = min(u, n - 1 - j)
         for r in range(1, m + 1):
-            l = t[j, r]
+            lower = t[j, r]
             for c in range(k):
-                x[j, c] -= l * x[j + r, c]
+                x[j, c] -= lower * x[j + r, c]
     return x
 
 

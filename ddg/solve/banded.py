@@ -101,7 +101,8 @@ class SymmetricBanded:
             x = ldlt.solve(rhs)
             columns = (x,) if x.ndim == 1 else x.T
             targets = (rhs,) if x.ndim == 1 else np.asarray(rhs).T
-            if all(np.all(np.isfinite(c)) and np.linalg.norm(self.matvec(c) - b) <= self.LDLT_RESIDUAL * np.linalg.norm(b)
+            tolerance = self.LDLT_RESIDUAL
+            if all(np.all(np.isfinite(c)) and np.linalg.norm(self.matvec(c) - b) <= tolerance * np.linalg.norm(b)
                    for c, b in zip(columns, targets)):
                 return x
         u = self.band.shape[0] - 1

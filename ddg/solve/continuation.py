@@ -56,8 +56,10 @@ class ContinuationOptions:
         if not isinstance(self.newton, NewtonOptions):
             raise InputError(f"ContinuationOptions(newton={self.newton!r}): must be a ddg.NewtonOptions")
         self.newton = replace(self.newton)  # validated again: options objects can be changed after creation
-        c = lambda name, *args, **kw: setattr(self, name, check_option("ContinuationOptions", name, getattr(self, name),
-                                                                      *args, **kw))  # noqa: E731
+
+        def c(name, *args, **kw):
+            setattr(self, name, check_option("ContinuationOptions", name, getattr(self, name), *args, **kw))
+
         # below 2^-30 of a recorded interval the substeps are lost in round-off of the load
         c("min_substep", "float", 2.0**-30, 1.0)
         c("easy_iterations", "int", 0, 1000)
@@ -67,9 +69,11 @@ class ContinuationOptions:
         c("jump_substep", "float", 0.0, 1.0, low_open=True)
         c("grow_after", "int", 1, 1000)
         if self.predictor not in self.PREDICTORS:
-            raise InputError(f"ContinuationOptions(predictor={self.predictor!r}): choose one of {list(self.PREDICTORS)}")
+            raise InputError(f"ContinuationOptions(predictor={self.predictor!r}): "
+                             f"choose one of {list(self.PREDICTORS)}")
         if isinstance(self.branch_sign, bool) or self.branch_sign not in (1, -1):
-            raise InputError(f"ContinuationOptions(branch_sign={self.branch_sign!r}): must be +1 (US+, S+) or -1 (US-, S-)")
+            raise InputError(f"ContinuationOptions(branch_sign={self.branch_sign!r}): must be +1 (US+, S+) or -1 (US-, "
+                             f"S-)")
 
 
 class PathFollower:
@@ -160,7 +164,8 @@ class PathFollower:
             compression *= 0.5
         raise ContinuationFailure(
             f"Newton failed to find the buckled state at the start of compression (tried dL/L from "
-            f"{first / self._length:.4g} down to {compression / self._length:.4g}); only the flat state at dL/L = 0 converged"
+            f"{first / self._length:.4g} down to {compression / self._length:.4g}); only the flat state at dL/L = 0 "
+            f"converged"
         )
 
     def advance(self, state: State, compression: float, shear: float) -> State:
@@ -193,7 +198,8 @@ class PathFollower:
                 if self.substep < self.options.min_substep:
                     strip = self.model.strip
                     limit = strip.shear_limit(state.compression) if state.compression > 0 else float("nan")
-                    reach = (f"; that is {100 * abs(state.shear) / limit:.2f} % of dW_max/L = {limit / self._length:.4g} "
+                    reach = (f"; that is {100 * abs(state.shear) / limit:.2f} % of dW_max/L = "
+                             f"{limit / self._length:.4g} "
                              "(Eq. B.1)") if state.shear != 0.0 and limit > 0 else ""
                     fold = ""
                     if self.folds and abs(self.folds[-1] - state.shear) < abs(target[1] - start[1]) + 1e-12:
@@ -277,8 +283,11 @@ class PathFollower:
         span = abs(shear - state.shear) / self._length
         tracer = ArclengthTracer(model, self.options.newton,
                                  ArclengthOptions(initial_step=span / 4, max_step=max(span, 1e-4), max_points=40))
-        points, _ = tracer.trace(state, direction,
-                                 stop=lambda s: (s.shear - shear) * direction >= 0 or (s.shear - state.shear) * direction < 0)
+
+        def past_either_end(s):
+            return (s.shear - shear) * direction >= 0 or (s.shear - state.shear) * direction < 0
+
+        points, _ = tracer.trace(state, direction, stop=past_either_end)
         self._spent(tracer.newton_iterations, "fold snaps")
         shears = np.array([state.shear] + [p.shear for p in points])
         if points and (points[-1].shear - shear) * direction >= 0:
@@ -345,7 +354,8 @@ class PathFollower:
             q[model.constrained] = model.clamp_values(compression, between)
             result = newton(model, q, self.options.newton)
             self._spent(result.iterations, "fold snaps", result.converged)
-            if not result.converged or phase_of(model, State(result.q, None, compression, between, False)).startswith("US"):
+            if not result.converged or phase_of(model, State(result.q, None, compression, between,
+                                                             False)).startswith("US"):
                 return None
             model.commit(result.q, result.evaluation)
             junction = State(result.q, result.evaluation, compression, between, bool(result.positive_definite))
@@ -545,8 +555,10 @@ def relax_from(model, source_model, source_state: State, options: ContinuationOp
     result = newton(model, source_state.q, options.newton, minimize=True)
     if not result.converged:
         L = model.strip.length
-        raise ContinuationFailure(f"the ribbon did not relax from the rod state at dL/L = {source_state.compression / L:.6g}, "
-                                  f"dW/L = {source_state.shear / L:.6g} ({result.message or 'Newton did not converge'})")
+        raise ContinuationFailure(f"the ribbon did not relax from the rod state at dL/L = "
+                                  f"{source_state.compression / L:.6g}, "
+                                  f"dW/L = {source_state.shear / L:.6g} "
+                                  f"({result.message or 'Newton did not converge'})")
     model.commit(result.q, result.evaluation)
     return State(result.q, result.evaluation, source_state.compression, source_state.shear,
                  bool(result.positive_definite), result.iterations)

@@ -122,7 +122,8 @@ class DynamicOptions:
         steps = travel / self.clamp_speed / self.time_step  # inf, not an overflow, for a denormal speed
         if steps > MAX_TIME_STEPS:
             slowest = travel / MAX_TIME_STEPS / self.time_step
-            raise InputError(f"clamp_speed = {self.clamp_speed:g} m/s needs {steps:.3g} time steps of {self.time_step:g} s "
+            raise InputError(f"clamp_speed = {self.clamp_speed:g} m/s needs {steps:.3g} time steps of "
+                             f"{self.time_step:g} s "
                              f"({travel / self.clamp_speed:.3g} s of loading); allowed up to {MAX_TIME_STEPS:g} "
                              f"steps, i.e. clamp_speed >= {slowest:.3g} m/s")
 

@@ -73,8 +73,9 @@ class NewtonOptions:
     give_up_ratio: float = 0.1
 
     def __post_init__(self) -> None:
-        c = lambda name, *args, **kw: setattr(self, name, check_option("NewtonOptions", name, getattr(self, name),
-                                                                      *args, **kw))  # noqa: E731
+        def c(name, *args, **kw):
+            setattr(self, name, check_option("NewtonOptions", name, getattr(self, name), *args, **kw))
+
         c("max_iterations", "int", 1, 1000)
         c("residual_tol", "float", 0.0, 1e-3, low_open=True)
         c("step_tol", "float", 0.0, 1e-3, low_open=True)
@@ -159,9 +160,9 @@ def _newton(model, q, options, minimize, evaluation):
                 if res <= ROUNDOFF_STALL_FACTOR * model.residual_floor():
                     # the residual is round-off: q is the equilibrium to within it
                     return NewtonResult(q, ev, True, iteration, res, pd, "converged to round-off"), trials
-                return NewtonResult(q, ev, False, iteration, res, pd,
-                                    f"stalled at scaled residual {res:.3g} (tolerance {residual_tol:.3g}): "
-                                    f"Newton corrections below {options.step_tol:g} for {tiny_steps} iterations"), trials
+                stalled = (f"stalled at scaled residual {res:.3g} (tolerance {residual_tol:.3g}): "
+                           f"Newton corrections below {options.step_tol:g} for {tiny_steps} iterations")
+                return NewtonResult(q, ev, False, iteration, res, pd, stalled), trials
             if tiny_steps == 1:
                 stall_residual = res
         else:

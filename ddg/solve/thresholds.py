@@ -28,7 +28,8 @@ def _follower(model, options, switching: bool) -> PathFollower:
     return PathFollower(model, replace(options, branch_switching=switching))
 
 
-def _advance(model, options, snapshot: Snapshot, shear: float, switching: bool, spent: list | None = None) -> State | None:
+def _advance(model, options, snapshot: Snapshot, shear: float, switching: bool,
+             spent: list | None = None) -> State | None:
     model.restore_frames(snapshot.frames)
     follower = _follower(model, options, switching)
     follower.remember(snapshot.state, restart=True)
@@ -152,7 +153,8 @@ def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | 
 
             out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L,
                                                spent)
-            out["dW2_S_stable"] = locate_sign_change(model, options, first_s, last_us.state.shear, tolerances[1] * L, spent)
+            out["dW2_S_stable"] = locate_sign_change(model, options, first_s, last_us.state.shear, tolerances[1] * L,
+                                                     spent)
     finally:
         model.restore_frames(saved)
         out["newton_iterations"] = spent[0]

@@ -128,9 +128,11 @@ def test_a_claim_without_data_does_not_hold():
 
 
 def _material(effect_dw1, gap_dw1, effect_h, gap_h, own_dw1=0.003, own_h=0.005):
-    return {"fem_dep_vs_nu0_dW1": effect_dw1, "plate_vs_fem_gold_dW1": gap_dw1, "fem_dep_vs_nu0_curve": effect_h,
-            "plate_vs_fem_gold_curve": gap_h, "plate_vs_fem_dep_dW1": own_dw1, "plate_vs_fem_dep_curve": own_h,
-            "fem_dep_resolution": 90, "plate_triangles": 5740}
+    from validation.verdicts import MaterialCheck
+
+    return MaterialCheck(fem_dep_vs_nu0_dW1=effect_dw1, plate_vs_fem_gold_dW1=gap_dw1, fem_dep_vs_nu0_curve=effect_h,
+                         plate_vs_fem_gold_curve=gap_h, plate_vs_fem_dep_dW1=own_dw1, plate_vs_fem_dep_curve=own_h,
+                         fem_dep_resolution=90, plate_triangles=5740)
 
 
 def test_material_sentence_follows_the_share_of_the_gap():
@@ -152,6 +154,18 @@ def test_material_sentence_follows_the_share_of_the_gap():
     assert "0.0050 L in H_mid (closer than its 0.0098 L to the nu = 0 shell)" in text
     far = material_sentence(_material(0.0004, 0.0064, 0.0071, 0.009754, 0.0070, 0.0120))
     assert "0.0070 in dW1/L (not closer than its 0.0064" in far and "0.0120 L in H_mid (not closer than" in far
+    no_gap = material_sentence(_material(0.0004, 0.0, 0.0071, 0.009754))
+    assert "in dW1/L the material changes the shell by 0.0004; the plate has no gap to explain" in no_gap
+    assert "dW1/L gap" not in no_gap and "the material may explain most of the H_mid gap" in no_gap
+
+
+def test_share_of_gap_levels_each_side_of_their_boundaries():
+    from validation.verdicts import ShareOfGap
+
+    for share, level in ((0.33, "small"), (0.34, "part"), (0.66, "part"), (0.67, "most"), (1.5, "most"),
+                         (1.51, "all")):
+        assert ShareOfGap("H_mid", " L", share * 0.01, 0.01).level == level, share
+    assert ShareOfGap("H_mid", " L", 0.001, 0.0).level == "no gap"
 
 
 def test_mesh_trend_sentence_says_whether_the_distance_falls_at_every_refinement():
@@ -196,7 +210,7 @@ def test_stability_map_outcome_follows_each_run_summary():
     the mesh or never bracketed, the rod's dW1 within 0.03 of the reference's or beyond."""
     from types import SimpleNamespace
 
-    from validation.report import stability_map
+    from validation.report_data import stability_map
 
     rows = [{"stage": "shear", "dW_over_L": 0.5}]
 
@@ -221,15 +235,16 @@ def test_stability_map_outcome_follows_each_run_summary():
 
 
 def test_claims_are_asserted_as_the_report_says():
-    """validation.report.CLAIMS_TESTED_TEXT describes this module: every claim asserted with
-    holds(key, ...) in a test, plate_elastica and rod_vs_plate_narrow_U on a 1000-triangle plate,
-    plate_dW1_paper_sixth marked slow, no test marked as an expected failure."""
+    """The report's text on the tests (templates/sentences.j2, claims_tested) describes this module:
+    every claim asserted with holds(key, ...) in a test, plate_elastica and rod_vs_plate_narrow_U on a
+    1000-triangle plate, plate_dW1_paper_sixth marked slow, no test marked as an expected failure."""
     import inspect
     import re
     import sys
 
-    from validation.report import CLAIMS_TESTED_TEXT
+    from validation.report import sentence
 
+    CLAIMS_TESTED_TEXT = sentence("claims_tested")
     module = sys.modules[__name__]
     asserted = {}
     for name, func in inspect.getmembers(module, inspect.isfunction):
@@ -245,6 +260,185 @@ def test_claims_are_asserted_as_the_report_says():
     assert "plate_dW1_paper_sixth only with `pytest -m slow`" in CLAIMS_TESTED_TEXT
     assert not any("xfail" in names for names in marks.values())
     assert "none is marked as an expected failure" in CLAIMS_TESTED_TEXT
+
+
+# ---------------------------------------------------------------------------- templates
+def _hand_made_report(claims=None):
+    """A ReportData built by hand (no model run): two claims, a row in every table, one figure."""
+    from validation.report_data import FigureData, Provenance, ReportData, Snapshots, Table, Timings
+
+    claims = claims if claims is not None else [C.evaluate("rod_elastica", 2e-4), C.evaluate("fem_elastica", 1e-4)]
+    claims[0] = {**claims[0], "statement": "a <b> & c | d"}  # escaped in HTML, '|' kept out of the Markdown table
+    thresholds = [{"model": "rod", "compression_ratio": 0.5, "width_ratio": 0.05, "dW1_over_L": 0.3516,
+                   "paper_dW1": 0.36, "dW1_rel_diff_vs_paper": 0.3516 / 0.36 - 1, "dW2_over_L": 0.4598,
+                   "paper_dW2": 0.52, "dW2_rel_diff_vs_paper": 0.4598 / 0.52 - 1, "dW2_S_stable_over_L": None,
+                   "dW1_drop_vs_W_1_20_percent": 0.0, "paper_drop_percent": None, "dW_max_over_L": 0.8175}]
+    speed = [{"model": "plate", "resolution": 1000, "wall_time_s": 15.33, "curve_error": 0.08721,
+              "dW1_error": 0.01084, "converged": True}]
+    conv = [{"model": "rod", "resolution": 50, "width_ratio": 0.05, "elastica_rel_error": -0.002527,
+             "curve_error_vs_finest": None, "dW1_over_L": 0.351, "dW2_over_L": 0.5228, "wall_time_s": 2.2}]
+    smap = [{"model": "ribbon", "compression_ratio": 0.5, "width_ratio": 0.05, "resolution": 101, "poisson_ratio": 0.0,
+             "outcome": "missed pitchfork", "reached_dW_over_L": 0.8175, "dW_max_over_L": 0.8175,
+             "reached_percent_of_dW_max": 100.0, "resolved_up_to_dW_over_L": 0.8175,
+             "rod_dW1_minus_reference": None, "message": "path complete"}]
+    tables = {"claims": Table("claims", list(claims[0]), claims, csv=True),
+              "thresholds": Table("thresholds", list(thresholds[0]), thresholds, csv=True),
+              "speed_accuracy": Table("speed_accuracy", list(speed[0]), speed),
+              "convergence": Table("convergence", list(conv[0]), conv),
+              "stability_map": Table("stability_map", list(smap[0]), smap, csv=True,
+                                     shown=[c for c in smap[0] if c != "message"])}
+    figure = FigureData("poisson", "poisson", "Rod, nu against nu = 0.", ["poisson_ratio", "dW_over_L", "H_mid_over_L"],
+                        [[0.0, 0.0, 0.1], [0.0, 0.1, 0.2]], png=b"not really a PNG")
+    return ReportData(Provenance("hand", 3, 3, 4, [(0.5, 0.05)], [(0.5, 1 / 6)]), claims, tables, "FEM gold",
+                      {0.25: {"max_H_difference_over_L": 0.0101, "dW1_difference": 0.0078}}, None,
+                      Snapshots(skipped="no plate runs"), [figure],
+                      Timings(model_wall_time_s=3.4, report_wall_time_s=12.0))
+
+
+def _md_row(row: dict, columns: list[str]) -> str:
+    from validation.report import cell
+
+    return "| " + " | ".join(cell(row.get(c)).replace("|", "/") for c in columns) + " |"
+
+
+def _html_row(row: dict, columns: list[str]) -> str:
+    import html
+
+    from validation.report import cell
+
+    return "".join(f"<td>{html.escape(cell(row.get(c)))}</td>" for c in columns)
+
+
+def test_templates_render_every_table_row_and_claim_from_the_data():
+    pytest.importorskip("jinja2")
+    from validation.report import render_html, render_markdown
+
+    data = _hand_made_report()
+    md, page = render_markdown(data), render_html(data)
+    for table in data.tables.values():
+        for row in table.rows:
+            assert _md_row(row, table.shown_columns) in md.splitlines(), (table.name, row)
+            assert _html_row(row, table.shown_columns) in page, (table.name, row)
+    for claim in data.claims:
+        assert claim["claim"] in md and claim["reason"] in md and claim["claim"] in page
+    assert "a <b> & c / d" in md and "a &lt;b&gt; &amp; c | d" in page and "<b>" not in page  # HTML autoescaped
+    assert "message" not in md and "path complete" not in md  # the stability map's hidden column
+    assert "3 model runs (3 requested), FEM gold scenes used: 1; no FEM gold data for dL/L=1/2 W/L=1/6" in md
+    assert "- ribbon W/L = 1/20, dL/L = 1/2 (resolution 101): missed pitchfork; reached 0.8175 of dW_max 0.8175" in md
+    assert "- rod at W/L = 1/20, dL/L = 1/2: dW2/L = 0.4598 against the paper's 0.52 (-11.6 %)." in md
+    assert "dW1/L = 0.3516" not in md  # -2.3 % from the paper: within the 10 % the list states
+    assert "- nu = 0.25 vs nu = 0: max |H_mid difference| = 0.0101 L, dW1 difference = 0.0078" in md
+    assert "![poisson](figures/poisson.png)" in md and "*Rod, nu against nu = 0.*" in md
+    assert page.count("data:image/png;base64,") == 1 and data.figures[0].png_base64 in page
+    assert "Report built in 12 s" in md and "Report built in 12 s" in page
+    assert "Skipped: no plate run of this profile kept its frames" in md
+
+
+def test_a_failing_claim_renders_as_failing():
+    """The verdict word follows the numbers: above its bound a claim is listed as not holding, in
+    bold, its row flagged in the HTML; at or below its bound every claim holds."""
+    pytest.importorskip("jinja2")
+    from validation.report import render_html, render_markdown
+
+    bound = C.CLAIMS["fem_elastica"].bound
+    failing = _hand_made_report([C.evaluate("rod_elastica", 2e-4), C.evaluate("fem_elastica", 1.01 * bound)])
+    md, page = render_markdown(failing), render_html(failing)
+    assert f"**1 of 2 claims do not hold: fem_elastica (measured {1.01 * bound:.4g} > bound {bound:g}).**" in md
+    assert "All 2 claims hold" not in md and "All 2 claims hold" not in page
+    fem_row = next(line for line in md.splitlines() if line.startswith("| fem_elastica |"))
+    assert "| False |" in fem_row
+    assert page.count('class="fails"') == 1 and "<strong>1 of 2 claims do not hold" in page
+    holding = _hand_made_report([C.evaluate("rod_elastica", 2e-4), C.evaluate("fem_elastica", bound)])
+    md, page = render_markdown(holding), render_html(holding)
+    assert "All 2 claims hold: each measured value is at or below its bound." in md and "do not hold" not in md
+    assert 'class="fails"' not in page and "All 2 claims hold" in page
+
+
+def test_paper_disagreements_are_the_rows_beyond_the_stated_limit():
+    from validation.verdicts import PAPER_DISAGREEMENT, paper_disagreements
+
+    def row(diff):
+        return {"model": "rod", "width_ratio": 0.05, "compression_ratio": 0.5,
+                "dW1_over_L": None if diff is None else 0.36 * (1 + diff), "paper_dW1": 0.36,
+                "dW1_rel_diff_vs_paper": diff, "dW2_rel_diff_vs_paper": None}
+
+    listed = paper_disagreements([row(0.99 * PAPER_DISAGREEMENT), row(-1.01 * PAPER_DISAGREEMENT), row(None)])
+    assert [d["rel_diff"] for d in listed] == [-1.01 * PAPER_DISAGREEMENT]
+    assert listed[0]["percent"] == pytest.approx(-101 * PAPER_DISAGREEMENT)
+
+
+def test_a_missing_jinja2_stops_the_report_before_any_run_with_one_line(monkeypatch, tmp_path, capsys):
+    import sys
+
+    from validation import report
+    from validation.__main__ import main
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a run started without the report's extras")
+
+    monkeypatch.setitem(sys.modules, "jinja2", None)  # `import jinja2` raises ImportError
+    monkeypatch.setattr(report, "run_all", refuse)
+    with pytest.raises(report.MissingExtra) as error:
+        report.build_report("smoke", tmp_path / "out")
+    message = str(error.value)
+    assert "\n" not in message and "jinja2" in message and "pip install 'ddg-strips[report]'" in message
+    assert not (tmp_path / "out").exists()
+    with pytest.raises(report.MissingExtra):
+        report.render_markdown(_hand_made_report())
+    assert main(["report", "--smoke", "--out", str(tmp_path / "cli"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err == f"error: {message}\n"
+
+
+def test_a_figure_is_drawn_from_its_rows_alone(tmp_path):
+    """Every figure kind from hand-made rows and marks (no run), saved as PNG, PDF and CSV."""
+    pytest.importorskip("matplotlib")
+    from validation import figures
+    from validation.report import draw_figures
+    from validation.report_data import FigureData
+
+    curve = [["rod", 0.5, 0.05, 0.1 * i, 0.01 * i] for i in range(5)] + [["fem", 0.5, 0.05, 0.2, 0.02]]
+    marks = {"panels": [(0.5, 0.05)], "thresholds": [{"model": "rod", "compression_ratio": 0.5, "width_ratio": 0.05,
+                                                      "dW1_over_L": 0.2, "dW2_over_L": None}]}
+    items = [
+        FigureData("elastica", "elastica", "", ["model", "width_ratio", "dL_over_L", "H_mid_over_L", "exact"],
+                   [["rod", 0.05, 0.1, 0.2, 0.2], ["fem", 1 / 6, 0.1, 0.21, 0.2]], {"exact": [(0.0, 0.0), (0.1, 0.2)]}),
+        FigureData("shear", "shear_curves", "",
+                   ["model", "compression_ratio", "width_ratio", "dW_over_L", "H_mid_over_L"], curve,
+                   {**marks, "paper": [{"width_ratio": 0.05, "key": "dW1", "value": 0.36}]}),
+        FigureData("force", "shear_force", "", ["model", "compression_ratio", "width_ratio", "dW_over_L",
+                                                "F_shear_norm"], curve, marks),
+        FigureData("stability", "stability_map", "", ["model", "compression_ratio", "width_ratio", "outcome",
+                                                      "reached_percent_of_dW_max"],
+                   [["rod", 0.5, 0.05, "ok", 100.0], ["plate", 0.25, 0.1, "missed pitchfork", None]]),
+    ]
+    assert set(figures.DRAW) >= {item.kind for item in items}
+    draw_figures(items, tmp_path)
+    for item in items:
+        assert item.png.startswith(b"\x89PNG")
+        for path in item.files.values():
+            assert (tmp_path / path).stat().st_size > 0
+        assert (tmp_path / item.files["csv"]).read_text().count("\n") == len(item.rows) + 1
+
+
+def test_each_validation_module_imports_first_without_the_report_extras():
+    """Every module of the package imported first in a fresh interpreter (an import circle would
+    fail for one of them), none importing jinja2 or matplotlib: those load where rendering happens."""
+    import pathlib
+    import subprocess
+    import sys
+
+    import validation
+
+    names = sorted(p.stem for p in pathlib.Path(validation.__file__).parent.glob("*.py"))
+    assert {"report", "report_data", "figures", "verdicts"} <= set(names)
+    check = ("import importlib, sys; importlib.import_module(sys.argv[1]); "
+             "loaded = [m for m in ('jinja2', 'matplotlib') if m in sys.modules]; assert not loaded, loaded")
+    procs = {name: subprocess.Popen([sys.executable, "-c", check, f"validation.{name}"], stderr=subprocess.PIPE,
+                                    text=True) for name in names}
+    failed = {name: proc.communicate()[1].strip().splitlines()[-1:] for name, proc in procs.items()
+              if proc.wait() != 0}
+    assert not failed
 
 
 # ---------------------------------------------------------------------------- claims
@@ -318,7 +512,7 @@ def test_claim_plate_and_fem_agree_on_the_H_mid_curve(plate_sixth_fine):
 
 
 def test_claim_plate_and_the_shell_with_its_material_agree(plate_sixth_fine):
-    from validation.report import load_dep_material
+    from validation.reference import load_dep_material
 
     dep = load_dep_material()
     if dep is None:
@@ -336,7 +530,7 @@ def test_snapshots_show_the_plate_states_from_its_frames(tmp_path):
 
     import numpy as np
 
-    from validation import report
+    from validation import report, report_data
     from validation.studies import Profile
 
     strip = ddg.Strip.from_ratios(1 / 6, 1 / 2)
@@ -344,14 +538,16 @@ def test_snapshots_show_the_plate_states_from_its_frames(tmp_path):
     ddg.simulate(strip, protocol, model="plate", resolution=400, branches=False, frames=True, out=tmp_path / "run")
     spec = R.RunSpec("plate", 1 / 6, 1 / 2, 400, frames=True)
     run = R.load(tmp_path / "run", spec)
-    states = report.snapshot_states(run)
+    states = report_data.snapshot_states(run)
     phases = [phase.rstrip("+-") for phase, _, _ in states]
     assert phases[:2] == ["U", "US"]
     dw1 = run.summary["dW1_over_L"]
     assert states[0][1] < dw1 < states[1][1]
     profile = Profile("test", [], {"plate": 400}, [], [], (), {}, {})
-    note = report.figure_snapshots(report.Figures(tmp_path / "out"), {spec: run}, profile)
-    assert note.startswith(f"{len(states)} shapes")
+    figure, snapshots = report_data.snapshot_data({spec: run}, profile)
+    assert snapshots.shapes == len(states) and snapshots.skipped is None
+    assert report.sentence("snapshots", snapshots).startswith(f"{len(states)} shapes")
+    report.draw_figures([figure], tmp_path / "out")
     for ext in ("png", "pdf", "csv"):
         assert (tmp_path / "out" / "figures" / f"snapshots_3d.{ext}").stat().st_size > 0
     with open(tmp_path / "out" / "figures" / "snapshots_3d.csv") as f:

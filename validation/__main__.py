@@ -21,9 +21,13 @@ def main(argv=None) -> int:
     if args.jobs < 1:
         sys.stderr.write(f"error: --jobs = {args.jobs} must be >= 1\n")
         return 2
-    from .report import build_report
+    from .report import MissingExtra, build_report
 
-    summary = build_report(args.profile or "quick", args.out, jobs=args.jobs, progress=not args.quiet)
+    try:
+        summary = build_report(args.profile or "quick", args.out, jobs=args.jobs, progress=not args.quiet)
+    except MissingExtra as exc:
+        sys.stderr.write(f"error: {exc}\n")
+        return 2
     print(f"report: {args.out}/index.html ({summary['runs']} runs, {summary['report_wall_time_s']:.0f} s); "
           f"claims failing: {summary['claims_failing'] or 'none'}")
     return 0

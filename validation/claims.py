@@ -43,11 +43,13 @@ CLAIMS = {c.key: c for c in (
           "U branch (dW up to 0.02 below the first dW1)", 0.01),
     Claim("plate_vs_fem_curve", "plate (about 6000 triangles) vs FEM gold at W/L = 1/6, dL/L = 1/2: largest H_mid "
           "difference/L over the shear, 0.02 away from either model's thresholds", 0.01),
-    Claim("plate_vs_fem_dW1", "plate (about 6000 triangles) vs FEM gold at W/L = 1/6, dL/L = 1/2: dW1 difference/L", 0.02),
+    Claim("plate_vs_fem_dW1", "plate (about 6000 triangles) vs FEM gold at W/L = 1/6, dL/L = 1/2: dW1 difference/L",
+          0.02),
     Claim("plate_vs_fem_own_material_curve", "plate (about 6000 triangles) vs the FEM shell with the plate's material "
           "(data/fem_dep, 90 x 15) at W/L = 1/6, dL/L = 1/2: largest H_mid difference/L, 0.02 away from the thresholds",
           0.01),
-    Claim("rod_thresholds_paper", "rod at W/L = 1/20 (dL/L = 1/2 and 1/4): largest difference of dW1, dW2 from the paper, /L", 0.02),
+    Claim("rod_thresholds_paper", "rod at W/L = 1/20 (dL/L = 1/2 and 1/4): largest difference of dW1, dW2 from the "
+          "paper, /L", 0.02),
     Claim("plate_dW1_paper_sixth", "plate at W/L = 1/6, dL/L = 1/2: dW1/L - 0.27, absolute", 0.03),
 )}
 

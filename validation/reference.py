@@ -55,6 +55,12 @@ def load_gold(compression_ratio: float, width_ratio: float, root: Path = FEM_GOL
     return GoldCurve(directory)
 
 
+def load_dep_material(root: Path = FEM_DEP) -> GoldCurve | None:
+    """The FEM shell run with the DDG plate's material at W/L = 1/6, dL/L = 1/2 (data/fem_dep), or None."""
+    directory = Path(root) / "dL0.5_W0.1667_N90"
+    return GoldCurve(directory) if (directory / "summary.json").exists() else None
+
+
 def curve_error(dw: np.ndarray, h: np.ndarray, dw_ref: np.ndarray, h_ref: np.ndarray,
                 exclude: list[float] = (), band: float = 0.02) -> float:
     """Largest |H(dW) - H_ref(dW)| (in units of L) over the common dW range, away from the given

@@ -1,0 +1,650 @@
+"""The validation report's data: one ReportData object computed from the runs, no rendering.
+
+Every number the report states comes from here: the tables (claims, thresholds, speed-accuracy,
+convergence, stability map) as rows, each figure as the rows of its CSV with the few marks it draws
+besides (validation/figures.py draws a figure from these alone), the claims as rows
+(validation/claims.py), the verdicts of the report's sentences (validation/verdicts.py), the
+timings and the provenance. validation/report.py renders it (templates, CSV, summary.json).
+"""
+from __future__ import annotations
+
+import base64
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ddg.analysis.analytic import clamped_elastica_midpoint_height
+from ddg.geometry.strip import shear_limit
+
+from . import claims as C
+from .reference import FEM_FINE, PAPER_DROPS_QUARTER, GoldCurve, load_dep_material, load_gold, paper_value
+from .studies import COMPRESSIONS, CROSS_MODEL_PLATE, SNAPSHOT_SCENES, SPEED_SCENE, Profile
+from .verdicts import (PAPER_DISAGREEMENT, ClaimsVerdict, MaterialCheck, MeshTrend, PaperReading, paper_disagreements,
+                       unusual_outcomes)
+
+MODELS = ("rod", "plate", "ribbon")
+CLAIM_COLUMNS = ["claim", "statement", "bound", "measured", "holds", "reason"]
+THRESHOLD_COLUMNS = ["model", "compression_ratio", "width_ratio", "dW1_over_L", "paper_dW1", "dW1_rel_diff_vs_paper",
+                     "dW2_over_L", "paper_dW2", "dW2_rel_diff_vs_paper", "dW2_S_stable_over_L",
+                     "dW1_drop_vs_W_1_20_percent", "paper_drop_percent", "dW_max_over_L"]
+
+
+def fraction(x: float) -> str:
+    """1/d for the ratios the paper uses (0.05 -> "1/20"), else 4 significant digits."""
+    for d in (2, 2.5, 3, 4, 5, 6, 8, 10, 12, 16, 20):
+        if abs(x - 1 / d) < 1e-6:
+            return f"1/{d:g}"
+    return f"{x:.4g}"
+
+
+# ---------------------------------------------------------------------------- the data object
+@dataclass
+class Table:
+    """Rows of one table (dicts keyed by column). `csv`: written as DIR/<name>.csv (the others'
+    numbers are in their figure's CSV); `shown`: the columns the report prints (default all)."""
+    name: str
+    columns: list[str]
+    rows: list[dict]
+    csv: bool = False
+    shown: list[str] | None = None
+
+    @property
+    def shown_columns(self) -> list[str]:
+        return self.columns if self.shown is None else self.shown
+
+
+@dataclass
+class FigureData:
+    """One figure: `rows` (in `columns` order) are its CSV and every number it plots from data;
+    `marks` the reference lines and layout it draws besides (analytic curves, paper values,
+    threshold lines, panels); `kind` names its drawing function in validation/figures.py.
+    `png` is set once drawn (the HTML embeds it)."""
+    name: str
+    kind: str
+    caption: str
+    columns: list[str]
+    rows: list[list]
+    marks: dict = field(default_factory=dict)
+    png: bytes | None = None
+
+    @property
+    def files(self) -> dict[str, str]:
+        return {ext: f"figures/{self.name}.{ext}" for ext in ("png", "pdf", "csv")}
+
+    @property
+    def png_base64(self) -> str:
+        return base64.b64encode(self.png or b"").decode()
+
+    def records(self) -> list[dict]:
+        return [dict(zip(self.columns, row)) for row in self.rows]
+
+
+@dataclass
+class Snapshots:
+    """The 3D snapshots: how many shapes, or why there are none ("no meshio", "no plate runs")."""
+    shapes: int = 0
+    skipped: str | None = None
+
+
+@dataclass
+class Provenance:
+    profile: str
+    runs: int                   # runs with a result
+    distinct_specs: int         # distinct runs the studies request
+    specs: int                  # runs the studies request, a run shared by studies counted for each
+    fem_gold_scenes: list[tuple[float, float]]
+    missing_fem_gold: list[tuple[float, float]]
+
+    @property
+    def fem_gold_names(self) -> list[str]:
+        return sorted(f"dL{c:g}_W{w:.4g}" for c, w in self.fem_gold_scenes)
+
+    @property
+    def missing_fem_gold_names(self) -> list[str]:
+        return sorted(f"dL/L={fraction(c)} W/L={fraction(w)}" for c, w in self.missing_fem_gold)
+
+
+@dataclass
+class Timings:
+    model_wall_time_s: float            # sum of the runs' own wall times (cached runs: when they ran)
+    report_wall_time_s: float | None = None  # this report, runs to figures; set by build_report
+
+
+@dataclass
+class ReportData:
+    """Everything the report states; the templates only lay it out."""
+    provenance: Provenance
+    claims: list[dict]                  # rows of validation.claims.evaluate
+    tables: dict[str, Table]            # claims, thresholds, speed_accuracy, convergence, stability_map
+    speed_reference: str
+    poisson: dict[float, dict]          # nu -> its curve's and dW1's difference from nu = 0
+    material: MaterialCheck | None
+    snapshots: Snapshots
+    figures: list[FigureData]
+    timings: Timings
+
+    @property
+    def claims_verdict(self) -> ClaimsVerdict:
+        return ClaimsVerdict(self.claims)
+
+    @property
+    def paper_reading(self) -> PaperReading:
+        return PaperReading.of(self.tables["thresholds"].rows)
+
+    @property
+    def paper_disagreement_limit(self) -> float:
+        return PAPER_DISAGREEMENT
+
+    @property
+    def paper_disagreements(self) -> list[dict]:
+        return paper_disagreements(self.tables["thresholds"].rows, self.paper_disagreement_limit)
+
+    @property
+    def unusual_outcomes(self) -> list[dict]:
+        return unusual_outcomes(self.tables["stability_map"].rows)
+
+
+# ---------------------------------------------------------------------------- reading runs
+def _shear(run, key):
+    return np.array([float(r[key]) for r in run.rows if r["stage"] == "shear"])
+
+
+def _comp(run, key):
+    return np.array([float(r[key]) for r in run.rows if r["stage"] == "compression"])
+
+
+def find_run(results, model, compression, width, resolution=None, poisson=0.0):
+    """The run of `results` ({RunSpec: run}) on a scene, or None."""
+    for spec, run in results.items():
+        if (spec.model == model and abs(spec.compression_ratio - compression) < 1e-9
+                and abs(spec.width_ratio - width) < 1e-9 and spec.poisson_ratio == poisson
+                and (resolution is None or spec.resolution == resolution)):
+            return run
+    return None
+
+
+def load_golds(scenes, gold_root: Path | None = None) -> dict:
+    """(dL/L, W/L) -> FEM gold curve, for the scenes that have one."""
+    golds = {}
+    for c, w in scenes:
+        gold = load_gold(c, w) if gold_root is None else load_gold(c, w, gold_root)
+        if gold is not None:
+            golds[(c, w)] = gold
+    return golds
+
+
+# ---------------------------------------------------------------------------- figures' data
+def elastica_figure(results, profile, golds) -> FigureData:
+    """Midpoint height under compression, models and FEM against the exact clamped elastica."""
+    rows = []
+    for model, width in (("rod", 1 / 20), ("plate", 1 / 6), ("plate", 1 / 20), ("ribbon", 1 / 20)):
+        run = find_run(results, model, 0.5, width, profile.models.get(model))
+        if run is None:
+            continue
+        dl, h = _comp(run, "dL_over_L"), _comp(run, "H_mid_over_L")
+        rows += [[model, width, a, b, clamped_elastica_midpoint_height(a) if a > 0 else 0.0] for a, b in zip(dl, h)]
+    gold = golds.get((0.5, 1 / 6))
+    if gold is not None:
+        dl, h = gold.column("dL_over_L", "compression"), gold.column("H_mid_over_L", "compression")
+        rows += [["fem", 1 / 6, a, b, clamped_elastica_midpoint_height(a) if a > 0 else 0.0] for a, b in zip(dl, h)]
+    exact = [(x, clamped_elastica_midpoint_height(x)) for x in np.linspace(1e-3, 0.6, 200)]
+    return FigureData("elastica", "elastica",
+                      "Midpoint height under compression (paper Fig. 5b): models against the exact clamped elastica.",
+                      ["model", "width_ratio", "dL_over_L", "H_mid_over_L", "exact_H_mid_over_L"], rows,
+                      {"exact": exact})
+
+
+def shear_column(results, profile, golds, compression, width, column) -> tuple[list[list], list[dict]]:
+    """`column` against dW/L on the shear stage for every model run of the scene and the FEM gold:
+    the rows [model, dL/L, W/L, dW/L, value] and each model run's dW1/L and dW2/L (for its lines)."""
+    rows, thresholds = [], []
+    curves = [(model, find_run(results, model, compression, width, profile.models.get(model)))
+              for model in MODELS] + [("fem", golds.get((compression, width)))]
+    for model, run in curves:
+        if run is None:
+            continue
+        dw, y = _shear(run, "dW_over_L"), _shear(run, column)
+        if model != "fem":
+            thresholds.append({"model": model, "compression_ratio": compression, "width_ratio": width,
+                               **{k: run.summary.get(k) for k in ("dW1_over_L", "dW2_over_L")}})
+        rows += [[model, compression, width, a, b] for a, b in zip(dw, y)]
+    return rows, thresholds
+
+
+def shear_curve_figures(results, profile, golds) -> list[FigureData]:
+    """H_mid/L against dW/L, one figure per compression, one panel per width (paper Figs. 6, 7)."""
+    figures = []
+    for compression in COMPRESSIONS:
+        scenes = [w for c, w in profile.shear_curves if c == compression]
+        if not scenes:
+            continue
+        rows, thresholds, paper = [], [], []
+        for width in scenes:
+            r, t = shear_column(results, profile, golds, compression, width, "H_mid_over_L")
+            rows += r
+            thresholds += t
+            paper += [{"width_ratio": width, "key": key, "value": paper_value(compression, width, key)}
+                      for key in ("dW1", "dW2") if paper_value(compression, width, key) is not None]
+        figures.append(FigureData(
+            f"hmid_vs_dW_dL{compression:g}", "shear_curves",
+            f"H_mid/L against dW/L at dL/L = {fraction(compression)} (paper Figs. 6, 7); dotted: dW1, dashed: "
+            "dW2 of each model (from stability); red triangles: the paper's quoted thresholds.",
+            ["model", "compression_ratio", "width_ratio", "dW_over_L", "H_mid_over_L"], rows,
+            {"panels": [(compression, w) for w in scenes], "thresholds": thresholds, "paper": paper}))
+    return figures
+
+
+def shear_force_figure(results, profile, golds) -> FigureData | None:
+    """Lateral clamp force against dW/L on the narrow and the 1/6 scene (paper Fig. E.18)."""
+    scenes = [s for s in ((0.5, 1 / 20), (0.5, 1 / 6)) if s in profile.shear_curves]
+    if not scenes:
+        return None
+    rows, thresholds = [], []
+    for compression, width in scenes:
+        r, t = shear_column(results, profile, golds, compression, width, "F_shear_norm")
+        rows += r
+        thresholds += t
+    return FigureData(
+        "shear_force", "shear_force",
+        "Lateral clamp force against dW/L (paper Fig. E.18); dotted: dW1, dashed: dW2 of each model (from "
+        "stability). tests/test_shear_force.py checks the force against the derivative of the energy along the path.",
+        ["model", "compression_ratio", "width_ratio", "dW_over_L", "F_shear_norm"], rows,
+        {"panels": scenes, "thresholds": thresholds})
+
+
+def threshold_table(results, profile, golds) -> list[dict]:
+    """dW1, dW2, dW2_S_stable per model and scene, against the paper's quoted values and drops."""
+    table = []
+    widths = sorted({w for _, w in profile.shear_curves} | set(profile.phase_widths))
+    for compression in COMPRESSIONS:
+        for width in widths:
+            entries = {}
+            for model in MODELS:
+                run = find_run(results, model, compression, width, profile.models.get(model))
+                if run is not None:
+                    entries[model] = run.summary
+            gold = golds.get((compression, width))
+            if gold is not None:
+                entries["fem"] = gold.summary
+            for model, s in entries.items():
+                row = {"model": model, "compression_ratio": compression, "width_ratio": width,
+                       "dW1_over_L": s.get("dW1_over_L"), "dW2_over_L": s.get("dW2_over_L"),
+                       "dW2_S_stable_over_L": s.get("dW2_S_stable_over_L"),
+                       "dW_max_over_L": shear_limit(1.0, width, compression)}
+                for key in ("dW1", "dW2"):
+                    paper = paper_value(compression, width, key)
+                    row[f"paper_{key}"] = paper
+                    ours = row[f"{key}_over_L"]
+                    row[f"{key}_rel_diff_vs_paper"] = None if paper is None or ours is None else ours / paper - 1
+                table.append(row)
+    # percent drops of dW1 against W/L = 1/20, per model and compression
+    for row in table:
+        base = next((r for r in table if r["model"] == row["model"]
+                     and r["compression_ratio"] == row["compression_ratio"] and abs(r["width_ratio"] - 1 / 20) < 1e-9),
+                    None)
+        row["dW1_drop_vs_W_1_20_percent"] = (
+            None if base is None or base["dW1_over_L"] is None or row["dW1_over_L"] is None
+            else 100 * (1 - row["dW1_over_L"] / base["dW1_over_L"]))
+        paper_drop = PAPER_DROPS_QUARTER.get(min(PAPER_DROPS_QUARTER, key=lambda w: abs(w - row["width_ratio"])))
+        close = any(abs(w - row["width_ratio"]) < 1e-9 for w in PAPER_DROPS_QUARTER)
+        row["paper_drop_percent"] = paper_drop if close and row["compression_ratio"] == 0.25 else None
+    return table
+
+
+def thresholds_figure(table) -> FigureData:
+    """The threshold table against W/L per compression (paper Fig. 8 phase boundaries)."""
+    rows, dw_max, paper = [], {}, []
+    for compression in COMPRESSIONS:
+        dw_max[compression] = [(x, shear_limit(1.0, x, compression)) for x in np.linspace(1 / 20, 1 / 2, 100)]
+        for model in MODELS + ("fem",):
+            sel = sorted((r for r in table if r["model"] == model and r["compression_ratio"] == compression),
+                         key=lambda r: r["width_ratio"])
+            rows += [[model, compression, r["width_ratio"], r["dW1_over_L"], r["dW2_over_L"], r["dW_max_over_L"]]
+                     for r in sel]
+        for width in sorted({r["width_ratio"] for r in table}):
+            paper += [{"compression_ratio": compression, "width_ratio": width, "key": key,
+                       "value": paper_value(compression, width, key)}
+                      for key in ("dW1", "dW2") if paper_value(compression, width, key) is not None]
+    return FigureData(
+        "thresholds_vs_width", "thresholds",
+        "Thresholds dW1/L (U to US) and dW2/L (US to S) against W/L (paper Fig. 8 phase boundaries), with the "
+        "shear limit dW_max.",
+        ["model", "compression_ratio", "width_ratio", "dW1_over_L", "dW2_over_L", "dW_max_over_L"], rows,
+        {"compressions": list(COMPRESSIONS), "dW_max": dw_max, "paper": paper})
+
+
+def convergence_data(results, study_specs) -> list[dict]:
+    """Per model and resolution: the compressed height's error, the H_mid curve against the finest run."""
+    data = []
+    by_model: dict[str, list] = {}
+    for spec in study_specs:
+        if spec in results:
+            by_model.setdefault(spec.model, []).append((spec, results[spec]))
+    for model, runs in by_model.items():
+        runs.sort(key=lambda t: t[0].resolution)
+        finest = runs[-1][1]
+        for spec, run in runs:
+            data.append({
+                "model": model, "resolution": spec.resolution, "width_ratio": spec.width_ratio,
+                "elastica_rel_error": C.elastica_error(run),
+                "curve_error_vs_finest": (C.curve_difference_away_from_thresholds(run, finest)
+                                          if run is not finest else None),
+                "dW1_over_L": run.summary.get("dW1_over_L"), "dW2_over_L": run.summary.get("dW2_over_L"),
+                "wall_time_s": run.summary.get("wall_time_s"),
+            })
+    return data
+
+
+def _records_figure(name: str, kind: str, caption: str, data: list[dict], marks: dict | None = None) -> FigureData:
+    """A figure whose CSV is a table's rows."""
+    return FigureData(name, kind, caption, list(data[0].keys()) if data else ["model"],
+                      [list(d.values()) for d in data], marks or {})
+
+
+def poisson_data(results, study_specs) -> tuple[FigureData, dict[float, dict]]:
+    """The rod's H_mid curve per Poisson ratio, and each curve's and dW1's difference from nu = 0."""
+    rows, curves = [], {}
+    for spec in study_specs:
+        run = results.get(spec)
+        if run is None:
+            continue
+        dw, h = _shear(run, "dW_over_L"), _shear(run, "H_mid_over_L")
+        curves[spec.poisson_ratio] = run
+        rows += [[spec.poisson_ratio, a, b] for a, b in zip(dw, h)]
+    spread = {}
+    if 0.0 in curves:
+        for nu, run in curves.items():
+            if nu != 0.0:
+                spread[nu] = {"max_H_difference_over_L": C.curve_difference_away_from_thresholds(run, curves[0.0]),
+                              "dW1_difference": C.threshold_difference(run, curves[0.0])}
+    figure = FigureData("poisson", "poisson",
+                        "Rod, W/L = 1/20, dL/L = 1/2: the Poisson ratio enters only GJ (paper Fig. G.20).",
+                        ["poisson_ratio", "dW_over_L", "H_mid_over_L"], rows)
+    return figure, spread
+
+
+def speed_accuracy(results, study_specs, golds) -> tuple[list[dict], str]:
+    """Wall time and error of each model and resolution on SPEED_SCENE, against the FEM gold (or
+    the finest run without it); the FEM shell's coarser stored meshes too. Returns (rows, reference)."""
+    gold = golds.get(SPEED_SCENE)
+    runs = [(s, results[s]) for s in study_specs if s in results]
+    if gold is not None:
+        reference = gold
+        ref_name = (f"FEM gold ({gold.summary['scene']['resolution']} elements along L; "
+                    "FEM points: coarser shell meshes)")
+    else:
+        if not runs:
+            return [], "none"
+        plates = [(s, r) for s, r in runs if s.model == "plate"] or runs
+        spec, reference = max(plates, key=lambda t: t[0].resolution)
+        ref_name = f"finest {spec.model} run (resolution {spec.resolution}; no FEM gold data for this scene)"
+    data = []
+    for spec, run in runs:
+        if run is reference:
+            continue
+        data.append({"model": spec.model, "resolution": spec.resolution, "wall_time_s": run.summary.get("wall_time_s"),
+                     "curve_error": C.curve_difference_away_from_thresholds(run, reference),
+                     "dW1_error": C.threshold_difference(run, reference),
+                     "converged": run.summary.get("converged")})
+    if gold is not None:  # the shell itself on coarser meshes (stored runs), against its gold mesh
+        for directory in sorted(FEM_FINE.glob("dL0.5_W0.1667_N*")):
+            if not (directory / "summary.json").exists():
+                continue
+            fem = GoldCurve(directory)
+            data.append({"model": "fem", "resolution": fem.summary["scene"]["resolution"],
+                         "wall_time_s": fem.summary.get("wall_time_s"),
+                         "curve_error": C.curve_difference_away_from_thresholds(fem, reference),
+                         "dW1_error": C.threshold_difference(fem, reference),
+                         "converged": fem.summary.get("converged")})
+    return data, ref_name
+
+
+def stability_map(results, golds, table) -> list[dict]:
+    """How each run ended and where it fails: Newton failure, unresolved mesh, missed pitchfork, or
+    the rod's width error (its dW1 against the plate's / FEM's at the same scene)."""
+    out = []
+    for spec, run in sorted(results.items(), key=lambda t: (t[0].model, t[0].compression_ratio, t[0].width_ratio,
+                                                            t[0].resolution or 0, t[0].poisson_ratio)):
+        s = run.summary
+        reached = max((float(r["dW_over_L"]) for r in run.rows if r["stage"] == "shear"), default=0.0)
+        dw_max = s.get("dW_max_over_L") or float("nan")
+        outcome = "ok"
+        if not s.get("converged"):
+            outcome = "Newton failure"
+        elif s.get("dW1_over_L") is None:  # located but past the mesh's resolution, or not bracketed at all
+            outcome = ("dW1 unresolved by the mesh" if (s.get("unresolved_thresholds") or {}).get("dW1_over_L")
+                       else "missed pitchfork")
+        resolved = s.get("resolved_up_to_dW_over_L")
+        if outcome == "ok" and resolved is not None and resolved < reached - 1e-9:
+            outcome = "ok (mesh unresolved near dW_max)"
+        width_error = None
+        if spec.model == "rod" and s.get("dW1_over_L") is not None:
+            ref = golds.get((spec.compression_ratio, spec.width_ratio))
+            ref_dw1 = ref.summary.get("dW1_over_L") if ref is not None else None
+            if ref_dw1 is None:
+                plate = next((r for r in table if r["model"] == "plate"
+                              and r["compression_ratio"] == spec.compression_ratio
+                              and abs(r["width_ratio"] - spec.width_ratio) < 1e-9), None)
+                ref_dw1 = plate["dW1_over_L"] if plate else None
+            if ref_dw1 is not None:
+                width_error = s["dW1_over_L"] - ref_dw1
+                if abs(width_error) > 0.03:
+                    outcome = "rod width error" if outcome == "ok" else outcome + ", rod width error"
+        out.append({"model": spec.model, "compression_ratio": spec.compression_ratio, "width_ratio": spec.width_ratio,
+                    "resolution": spec.resolution, "poisson_ratio": spec.poisson_ratio, "outcome": outcome,
+                    "reached_dW_over_L": reached, "dW_max_over_L": dw_max,
+                    "reached_percent_of_dW_max": 100 * reached / dw_max if dw_max else None,
+                    "resolved_up_to_dW_over_L": resolved, "rod_dW1_minus_reference": width_error,
+                    "message": s.get("message", "")})
+    return out
+
+
+# ---------------------------------------------------------------------------- 3D snapshots
+def _frame_index(frames_dir: Path) -> list[dict]:
+    """The frames.pvd collection of a run: [{step, file, dW_over_L, stage}], or [] if absent."""
+    import xml.etree.ElementTree as ET
+
+    pvd = frames_dir / "frames.pvd"
+    if not pvd.exists():
+        return []
+    return [{"step": int(d.get("timestep")), "file": frames_dir / d.get("file"), "stage": d.get("stage"),
+             "dW_over_L": float(d.get("dW_over_L"))} for d in ET.parse(pvd).getroot().iter("DataSet")]
+
+
+def snapshot_states(run) -> list[tuple[str, float, Path]]:
+    """(phase, dW/L, frame file) of a U, a US and an S state of a plate run: the recorded shear
+    state nearest to dW1/2 on U, to (dW1 + dW2)/2 on US (dW2 -> dW_end if S is never reached) and to
+    (dW2 + dW_end)/2 on S."""
+    frames = [f for f in _frame_index(run.directory / "frames") if f["stage"] == "shear"]
+    if not frames:
+        return []
+    s = run.summary
+    shear = [r for r in run.rows if r["stage"] == "shear"]
+    dw_end = max(float(r["dW_over_L"]) for r in shear)
+    dw1, dw2 = s.get("dW1_over_L"), s.get("dW2_over_L")
+    targets = {"U": 0.5 * dw1 if dw1 else 0.5 * dw_end,
+               "US": 0.5 * (dw1 + (dw2 or dw_end)) if dw1 else None,
+               "S": 0.5 * (dw2 + dw_end) if dw2 else None}
+    out = []
+    for phase, target in targets.items():
+        if target is None:
+            continue
+        rows = [r for r in shear if str(r["phase"]).rstrip("+-") == phase]
+        if not rows:
+            continue
+        row = min(rows, key=lambda r: abs(float(r["dW_over_L"]) - target))
+        frame = min(frames, key=lambda f: abs(f["dW_over_L"] - float(row["dW_over_L"])))
+        if abs(frame["dW_over_L"] - float(row["dW_over_L"])) < 1e-9:
+            out.append((str(row["phase"]), float(row["dW_over_L"]), frame["file"]))
+    return out
+
+
+def snapshot_data(results, profile) -> tuple[FigureData | None, Snapshots]:
+    """3D shapes of U, US and S plates, narrow and wide (paper Fig. 1), from the plate runs' frames:
+    the nodes (in L) as rows, each panel's triangles as marks."""
+    try:
+        import meshio
+    except ImportError:
+        return None, Snapshots(skipped="no meshio")
+    states = []
+    for compression, width in SNAPSHOT_SCENES:
+        run = find_run(results, "plate", compression, width, profile.models.get("plate"))
+        if run is not None:
+            states += [(compression, width, run, *state) for state in snapshot_states(run)]
+    if not states:
+        return None, Snapshots(skipped="no plate runs")
+    rows, panels = [], []
+    for width in sorted({s[1] for s in states}):
+        for compression, _, run, phase, dw, path in [s for s in states if s[1] == width]:
+            mesh = meshio.read(path)
+            xyz = mesh.points / float(run.summary["scene"]["length"])
+            panels.append({"compression_ratio": compression, "width_ratio": width, "phase": phase, "dW_over_L": dw,
+                           "triangles": mesh.cells_dict["triangle"]})
+            rows += [[compression, width, phase, dw, k, *map(float, p)] for k, p in enumerate(xyz)]
+    figure = FigureData(
+        "snapshots_3d", "snapshots",
+        "Deformed plates (paper Fig. 1): U, US and S states of a narrow and a wide strip at dL/L = 1/2, "
+        "from the plate runs' frames (U at dW1/2, US halfway between dW1 and dW2, S halfway from dW2 to "
+        "the end of the shear).",
+        ["compression_ratio", "width_ratio", "phase", "dW_over_L", "node", "x_over_L", "y_over_L", "z_over_L"], rows,
+        {"panels": panels})
+    return figure, Snapshots(shapes=len(panels))
+
+
+# ---------------------------------------------------------------------------- claims
+def material_check(results, golds) -> MaterialCheck | None:
+    """Is the plate/FEM gap at SPEED_SCENE the plate's material (the DEP's nu = 1/3 membrane and
+    nu_b = -1/3 bending, against the shell's nu = 0)? The material's effect (the FEM shell run with
+    the DEP's material, data/fem_dep, against the nu = 0 shell on the same mesh, data/fem_fine) is
+    set against the gap (the plate against the nu = 0 gold shell) and the plate against the shell
+    with its own material; with the plate's dW1 against its mesh where the profile runs several."""
+    iso_dir = FEM_FINE / "dL0.5_W0.1667_N90"
+    plate = find_run(results, "plate", *SPEED_SCENE, CROSS_MODEL_PLATE)
+    dep = load_dep_material()
+    gold = golds.get(SPEED_SCENE)
+    if dep is None or gold is None or not (iso_dir / "summary.json").exists() or plate is None:
+        return None
+    iso = GoldCurve(iso_dir)
+    numbers = {"fem_dep_vs_nu0_dW1": C.threshold_difference(dep, iso),
+               "fem_dep_vs_nu0_curve": C.curve_difference_away_from_thresholds(dep, iso),
+               "plate_vs_fem_gold_dW1": C.threshold_difference(plate, gold),
+               "plate_vs_fem_gold_curve": C.curve_difference_away_from_thresholds(plate, gold),
+               "plate_vs_fem_dep_dW1": C.threshold_difference(plate, dep),
+               "plate_vs_fem_dep_curve": C.curve_difference_away_from_thresholds(plate, dep),
+               "fem_dep_resolution": dep.summary["scene"]["resolution"],
+               "plate_triangles": plate.summary["mesh"]["triangles"]}
+    if any(v is None or not math.isfinite(v) for v in numbers.values()):
+        return None
+    plates = [(run.summary["mesh"]["triangles"], run.summary["dW1_over_L"]) for spec, run in results.items()
+              if spec.model == "plate" and (spec.compression_ratio, spec.width_ratio) == SPEED_SCENE
+              and not spec.poisson_ratio and run.summary.get("dW1_over_L") is not None]
+    trend = (MeshTrend(plates, gold.summary["dW1_over_L"])
+             if gold.summary.get("dW1_over_L") is not None and plates else None)
+    return MaterialCheck(**numbers, mesh_trend=trend)
+
+
+def _missing(**inputs) -> str:
+    """What a claim lacks: the names of the inputs that are None, joined ('' if none is)."""
+    return ", ".join(f"no {name}" for name, value in inputs.items() if value is None)
+
+
+def evaluate_claims(results, profile, golds) -> list[dict]:
+    """Every claim of validation/claims.py on this report's runs; a claim whose runs or reference
+    data are not in this profile does not hold (reason "no data: ..." naming what is missing)."""
+    get = lambda m, c, w: find_run(results, m, c, w, profile.models.get(m))  # noqa: E731
+    res = lambda m: "" if profile.models.get(m) is None else f", resolution {profile.models[m]}"  # noqa: E731
+    out = []
+    rod = find_run(results, "rod", 0.5, 1 / 20, 100)  # the claims are stated for M = 100
+    rod_quarter = find_run(results, "rod", 0.25, 1 / 20, 100)
+    plate6, plate20 = get("plate", 0.5, 1 / 6), get("plate", 0.5, 1 / 20)
+    plate6_fine = find_run(results, "plate", *SPEED_SCENE, CROSS_MODEL_PLATE)
+    gold6 = golds.get((0.5, 1 / 6))
+    dep6 = load_dep_material()
+    ribbon = get("ribbon", 0.5, 1 / 20)
+    names = {
+        "rod": "rod run (M = 100, W/L = 1/20, dL/L = 1/2)",
+        "rod_quarter": "rod run (M = 100, W/L = 1/20, dL/L = 1/4)",
+        "plate6": f"plate run (W/L = 1/6, dL/L = 1/2{res('plate')})",
+        "plate20": f"plate run (W/L = 1/20, dL/L = 1/2{res('plate')})",
+        "plate6_fine": f"plate run (W/L = 1/6, dL/L = 1/2, resolution {CROSS_MODEL_PLATE})",
+        "ribbon": f"ribbon run (W/L = 1/20, dL/L = 1/2{res('ribbon')})",
+        "gold6": "FEM gold data (data/fem_gold/dL0.5_W0.1667)",
+        "dep6": "FEM run with the plate's material (data/fem_dep/dL0.5_W0.1667_N90)",
+    }
+
+    def lacking(**inputs) -> str:
+        return _missing(**{names[k]: v for k, v in inputs.items()})
+
+    out.append(C.evaluate("rod_elastica", C.elastica_error(rod) if rod else None, lacking(rod=rod)))
+    out.append(C.evaluate("plate_elastica", C.elastica_error(plate6) if plate6 else None, lacking(plate6=plate6)))
+    out.append(C.evaluate("ribbon_elastica", C.elastica_error(ribbon) if ribbon else None, lacking(ribbon=ribbon)))
+    out.append(C.evaluate("fem_elastica", C.elastica_error(gold6) if gold6 else None, lacking(gold6=gold6)))
+    out.append(C.evaluate("rod_vs_plate_narrow_U", C.u_branch_difference(plate20, rod) if plate20 and rod else None,
+                          lacking(plate20=plate20, rod=rod)))
+    fine = lacking(plate6_fine=plate6_fine, gold6=gold6)
+    out.append(C.evaluate("plate_vs_fem_curve", C.curve_difference_away_from_thresholds(plate6_fine, gold6)
+                          if plate6_fine and gold6 else None, fine))
+    dw1 = C.threshold_difference(plate6_fine, gold6) if plate6_fine and gold6 else None
+    out.append(C.evaluate("plate_vs_fem_dW1", dw1, fine or "dW1 not located in the plate run or the FEM gold"))
+    out.append(C.evaluate("plate_vs_fem_own_material_curve", C.curve_difference_away_from_thresholds(plate6_fine, dep6)
+                          if plate6_fine and dep6 else None, lacking(plate6_fine=plate6_fine, dep6=dep6)))
+    rods = [r for r in (rod, rod_quarter) if r is not None]
+    errors = [C.paper_threshold_error(r) for r in rods]
+    out.append(C.evaluate("rod_thresholds_paper", max(errors) if len(errors) == 2 and None not in errors else None,
+                          lacking(rod=rod, rod_quarter=rod_quarter) or "a threshold the paper quotes was not located"))
+    dw1_sixth = plate6.summary.get("dW1_over_L") if plate6 else None
+    out.append(C.evaluate("plate_dW1_paper_sixth", abs(dw1_sixth - 0.27) if dw1_sixth is not None else None,
+                          lacking(plate6=plate6) or "dW1 not located in the plate run"))
+    return out
+
+
+# ---------------------------------------------------------------------------- the report's data
+def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None = None) -> ReportData:
+    """The report's data from the runs of `study` (validation.studies.specs) and the FEM gold data
+    (timings.report_wall_time_s is left for build_report, which knows when it started)."""
+    scenes = {(c, w) for c, w in profile.shear_curves} | {SPEED_SCENE}
+    golds = load_golds(sorted(scenes), gold_root)
+    all_specs = [s for group in study.values() for s in group]
+
+    figures = [elastica_figure(results, profile, golds), *shear_curve_figures(results, profile, golds)]
+    thresholds = threshold_table(results, profile, golds)
+    figures.append(thresholds_figure(thresholds))
+    force = shear_force_figure(results, profile, golds)
+    if force is not None:
+        figures.append(force)
+    conv = convergence_data(results, study["convergence"])
+    figures.append(_records_figure(
+        "convergence", "convergence",
+        "Convergence with resolution (paper Fig. C.16): compressed height against the exact elastica, and the "
+        "H_mid(dW) curve against the finest run (away from the thresholds).", conv))
+    poisson_figure, poisson = poisson_data(results, study["poisson"])
+    figures.append(poisson_figure)
+    speed, ref_name = speed_accuracy(results, study["speed"], golds)
+    figures.append(_records_figure(
+        "speed_accuracy", "speed_accuracy",
+        "Speed against accuracy: each model and resolution, wall time of the full path (thresholds included) "
+        f"against its error relative to the {ref_name}; dashed: the Pareto front.", speed, {"reference": ref_name}))
+    smap = stability_map(results, golds, thresholds)
+    figures.append(_records_figure("stability_map", "stability_map",
+                                   "Where each model fails and how (marker size: share of dW_max reached).", smap))
+    claims = evaluate_claims(results, profile, golds)
+    snapshot_figure, snapshots = snapshot_data(results, profile)
+    if snapshot_figure is not None:
+        figures.append(snapshot_figure)
+
+    smap_columns = list(smap[0].keys()) if smap else []
+    tables = {
+        "claims": Table("claims", CLAIM_COLUMNS, claims, csv=True),
+        "thresholds": Table("thresholds", THRESHOLD_COLUMNS, thresholds, csv=True),
+        "speed_accuracy": Table("speed_accuracy", list(speed[0].keys()) if speed else [], speed),
+        "convergence": Table("convergence", list(conv[0].keys()) if conv else [], conv),
+        "stability_map": Table("stability_map", smap_columns, smap, csv=True,
+                               shown=[c for c in smap_columns if c != "message"]),
+    }
+    provenance = Provenance(profile.name, len(results), len(set(all_specs)), len(all_specs),
+                            sorted(golds), sorted(scene for scene in scenes if scene not in golds))
+    timings = Timings(sum(float(r.summary.get("wall_time_s") or 0.0) for r in results.values()))
+    return ReportData(provenance, claims, tables, ref_name, poisson, material_check(results, golds), snapshots,
+                      figures, timings)

@@ -25,7 +25,6 @@ import math
 import os
 import subprocess
 import sys
-import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..geometry.strip import InputError
+from .io import atomic_path
 
 RENDER_EXTRA_MESSAGE = "install the 'render' extra: pip install ddg-strips[render]"
 HTML_EXTRA_MESSAGE = ("the HTML scene needs trame-pyvista and nest_asyncio2 besides the 'render' extra: "
@@ -439,17 +439,8 @@ def _write_png(image: np.ndarray, png_path) -> Path:
     from PIL import Image  # pillow: a dependency of pyvista
 
     png_path = Path(png_path)
-    png_path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{png_path.stem}.", suffix=".png", dir=png_path.parent)
-    os.close(fd)
-    try:
+    with atomic_path(png_path, suffix=".png") as tmp:
         Image.fromarray(image).save(tmp, format="PNG")
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, png_path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return png_path
 
 
@@ -610,16 +601,10 @@ def _export_html_child() -> None:
         _add_state(plotter, frame, color_by=color_by, clim=clim, show_edges=False, scalar_bar=True)
         fit = _as_fit_points(job["fit_to"]) if job.get("fit_to") else extent_points(frame)
         _fit_camera(plotter.renderer, fit, WINDOW_SIZE[0] / WINDOW_SIZE[1])
-        html = Path(job["html"])
-        html.parent.mkdir(parents=True, exist_ok=True)
-        tmp = html.with_name(f".{html.stem}.tmp.html")
         try:
-            with warnings.catch_warnings():
+            with atomic_path(Path(job["html"]), suffix=".html") as tmp, warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # pyvista >= 0.48 deprecates Plotter.export_html for .trame's
                 component = getattr(plotter, "trame", None)
                 (component.export_html if component is not None else plotter.export_html)(str(tmp))
-            os.chmod(tmp, 0o644)
-            os.replace(tmp, html)
         finally:
-            tmp.unlink(missing_ok=True)
             plotter.close()

@@ -22,12 +22,12 @@ from ddg.api import SimulationResult
 from ddg.output.io import write_centerline_csv, write_path_csv, write_summary_json
 from ddg.analysis.observables import resolved_up_to
 
+from .materials import MATERIALS
+
 FEM_COLUMNS = ("negative_eigenvalues", "half_turn_defect_over_L", "point_reflection_defect_over_L", "wall_time_s",
                "xdmf_time")
 DEFAULT_RESOLUTION = 60
 CENTERLINE_STATIONS = 101
-#: Materials of shell.ShellParameters (here, so that inputs are checked without importing dolfinx).
-MATERIALS = ("isotropic", "dep")
 
 
 def versions() -> dict:
@@ -103,7 +103,8 @@ def check_perturbation(value, name: str = "perturbation") -> float:
     try:
         number = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise InputError(f"{name} = {value!r} is not a number; allowed range [{low:g}, {high:g}] (units of L)") from None
+        raise InputError(f"{name} = {value!r} is not a number; "
+                         f"allowed range [{low:g}, {high:g}] (units of L)") from None
     if not (math.isfinite(number) and low <= number <= high):
         raise InputError(f"{name} = {value!r} outside the allowed range [{low:g}, {high:g}] (branch-switch start "
                          "amplitude in units of L)")

@@ -314,7 +314,8 @@ def switch_branch(stepper: Stepper, mode: np.ndarray, perturbation: float, growt
 
     The state is held at RMS amplitude A (units of L) along phi by a force mu M phi (bordered
     Newton, solver.newton_bordered), A growing from `perturbation` in increments that double
-    (up to max_increment, halved on failure, secant predictor) until the holding force changes sign (A passed the US amplitude); Newton without the constraint from
+    (up to max_increment, halved on failure, secant predictor) until the holding force changes
+    sign (A passed the US amplitude); Newton without the constraint from
     the interpolated state then lands on US+ (a pure perturbation of the U state followed by
     Newton falls back to U: the linear mode stretches the mid-surface at finite amplitude).
     Returns (iterations, amplitude) or raises ContinuationFailure unless the result is US with

@@ -97,7 +97,7 @@ EIGEN_NORMALISATION = ("lowest eigenvalue of the constrained tangent K v = lambd
 
 
 #: Materials of ShellParameters, and the DDG plate's effective Poisson ratios (material "dep").
-from .api import MATERIALS  # noqa: E402  (checked there before dolfinx is imported)
+from .materials import MATERIALS  # noqa: E402
 DEP_MEMBRANE_POISSON, DEP_BENDING_POISSON = 1.0 / 3.0, -1.0 / 3.0
 
 #: Below this r^2 sinc(r) and cos(r) are evaluated by their Taylor series in r^2 (no sqrt at 0).

@@ -1,0 +1,224 @@
+"""The sweep's phase diagram in the manner of the paper's Fig. 8: dW1/L and dW2/L against W/L, one
+panel per dL/L, one curve per model (and L/b, resolution), with the FEM shell's gold thresholds
+and their error bars where a mesh-convergence estimate exists (data/fem_gold, data/fem_convergence).
+
+matplotlib is optional (the 'plot' extra); `write_phase_diagram` raises ImportError without it.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import textwrap
+from pathlib import Path
+
+from ..geometry.strip import shear_limit
+
+#: The repository's data folder (gold data and its convergence studies); absent in an installed wheel.
+DATA = Path(__file__).resolve().parents[2] / "data"
+
+PHASE_COLOURS = {"U": "#dbe9f6", "US": "#fde6cf", "S": "#dff2de"}
+
+
+def gold_thresholds(data: Path = DATA) -> list[dict]:
+    """The FEM gold scenes (data/fem_gold/index.json) that converged: dL/L, W/L, dW1/L, dW2/L,
+    the mesh (elements along L) and the errors `dW1_error`, `dW2_error` estimated by the
+    Richardson extrapolation of data/fem_convergence/<scene>[_full]/thresholds.csv at that mesh
+    (None where no study exists: no error bar)."""
+    index = Path(data) / "fem_gold" / "index.json"
+    if not index.exists():
+        return []
+    out = []
+    for scene, entry in sorted(json.loads(index.read_text()).items()):
+        if not entry.get("converged"):
+            continue
+        errors = _convergence_errors(Path(data) / "fem_convergence", scene, entry.get("resolution"))
+        out.append({"scene": scene, "dL_over_L": entry["compression_ratio"], "W_over_L": entry["width_ratio"],
+                    "resolution": entry.get("resolution"), "dW1_over_L": entry.get("dW1_over_L"),
+                    "dW2_over_L": entry.get("dW2_over_L"), "dW1_error": errors.get("dW1_error"),
+                    "dW2_error": errors.get("dW2_error")})
+    return out
+
+
+def _convergence_errors(root: Path, scene: str, resolution) -> dict:
+    """dW1_error and dW2_error of the study's row at `resolution`; the whole-path study (_full)
+    first, then the dW1-only one."""
+    found: dict = {}
+    for folder in (root / f"{scene}_full", root / scene):
+        path = folder / "thresholds.csv"
+        if not path.exists() or resolution is None:
+            continue
+        with open(path, newline="") as fh:
+            for row in csv.DictReader(fh):
+                if row.get("resolution") != str(resolution):
+                    continue
+                for key in ("dW1_error", "dW2_error"):
+                    value = _number(row.get(key))
+                    if key not in found and value is not None:
+                        found[key] = value
+    return found
+
+
+def write_phase_diagram(out, rows: list[dict], data: Path = DATA) -> tuple[list[Path], str]:
+    """DIR/phase_diagram.png and .pdf from the table rows; returns the paths and the caption
+    (also printed under the figure)."""
+    import importlib
+
+    importlib.import_module("matplotlib")  # ImportError without the 'plot' extra, before any work
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    out = Path(out)
+    usable = [r for r in rows if r.get("dW1_over_L") is not None or r.get("dW2_over_L") is not None]
+    panels = sorted({r["dL_over_L"] for r in rows}, reverse=True) or [0.5]
+    gold = gold_thresholds(data)
+    caption = _caption(rows, usable, gold, panels)
+    fig = Figure(figsize=(5.2 * len(panels), 4.6))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, len(panels), squeeze=False)[0]
+    widths = sorted({r["W_over_L"] for r in rows} | {g["W_over_L"] for g in gold if _near(g["dL_over_L"], panels)})
+    for ax, compression in zip(axes, panels):
+        mine = [r for r in usable if r["dL_over_L"] == compression]
+        lo, hi = (min(widths), max(widths)) if widths else (0.05, 0.5)
+        logx = hi / lo > 3.0
+        xs = _span(lo, hi, logx)
+        limit = [shear_limit(1.0, w, compression) for w in xs]
+        ax.plot(xs, limit, color="0.55", lw=1.0, label=r"$\Delta W_{max}/L$ (Eq. B.1)")
+        series = _series(mine)
+        if series:
+            first = series[0][1]
+            _shade(ax, first, compression)
+        for number, (name, points) in enumerate(series):
+            colour = f"C{number % 10}"
+            w1 = [(p["W_over_L"], p["dW1_over_L"]) for p in points if p["dW1_over_L"] is not None]
+            w2 = [(p["W_over_L"], p["dW2_over_L"]) for p in points if p["dW2_over_L"] is not None]
+            if w1:
+                ax.plot(*zip(*w1), "o-", color=colour, ms=4, lw=1.4, label=f"{name}: $\\Delta W_1/L$")
+            if w2:
+                ax.plot(*zip(*w2), "s--", color=colour, ms=4, lw=1.4, mfc="white", label=f"{name}: $\\Delta W_2/L$")
+        for key, marker, label in (("dW1", "^", r"FEM shell (gold): $\Delta W_1/L$"),
+                                   ("dW2", "v", r"FEM shell (gold): $\Delta W_2/L$")):
+            pts = [g for g in gold if abs(g["dL_over_L"] - compression) < 1e-9 and g[f"{key}_over_L"] is not None]
+            if not pts:
+                continue
+            x = [g["W_over_L"] for g in pts]
+            y = [g[f"{key}_over_L"] for g in pts]
+            err = [g[f"{key}_error"] or 0.0 for g in pts]
+            ax.errorbar(x, y, yerr=err if any(err) else None, fmt=marker, color="black", ms=5, capsize=3,
+                        elinewidth=1.0, label=label, zorder=5)
+        if logx:
+            ax.set_xscale("log")
+            ax.minorticks_off()
+        ticks = _spread(sorted({r["W_over_L"] for r in rows}) or widths, lo, hi, logx)
+        ax.set_xticks(ticks)
+        ax.set_xticklabels([f"{w:.3g}" for w in ticks], fontsize=8)
+        ax.set_xlabel("W / L")
+        ax.set_ylabel(r"$\Delta W / L$")
+        ax.set_ylim(0.0, max(limit) * 1.02)
+        ax.set_title(f"$\\Delta L/L$ = {compression:g}", fontsize=10)
+        ax.legend(fontsize=6.5, loc="upper right")
+    wrapped = "\n".join(textwrap.wrap(caption, width=int(92 * len(panels))))
+    lines = wrapped.count("\n") + 1
+    fig.text(0.01, 0.01, wrapped, fontsize=7, va="bottom", ha="left")
+    fig.tight_layout(rect=(0, (lines * 7 * 1.25 + 8) / (4.6 * 72), 1, 1))
+    written = []
+    for suffix in ("png", "pdf"):
+        path = out / f"phase_diagram.{suffix}"
+        tmp = path.with_name(f".phase_diagram.tmp.{suffix}")
+        fig.savefig(tmp, dpi=150)
+        tmp.replace(path)
+        written.append(path)
+    return written, caption
+
+
+def _series(rows: list[dict]) -> list[tuple[str, list[dict]]]:
+    """Rows grouped by (model, L/b, resolution), each sorted by W/L; the name says what differs."""
+    groups: dict = {}
+    for r in rows:
+        groups.setdefault((r["model"], round(r["L_over_b"], 6), r["resolution"]), []).append(r)
+    slender = len({k[1] for k in groups}) > 1
+    resolutions = len({(k[0], k[2]) for k in groups}) > len({k[0] for k in groups})
+    out = []
+    for (model, lb, resolution), points in sorted(groups.items()):
+        name = model + (f" L/b={lb:.4g}" if slender else "") + (f" N={resolution}" if resolutions else "")
+        out.append((name, sorted(points, key=lambda p: p["W_over_L"])))
+    return out
+
+
+def _shade(ax, points: list[dict], compression: float) -> None:
+    """Phases U (below dW1), US (dW1 to dW2) and S (dW2 to dW_max) of one series, as in Fig. 8."""
+    pts = [p for p in points if p["dW1_over_L"] is not None and p["dW2_over_L"] is not None]
+    if len(pts) < 2:
+        return
+    x = [p["W_over_L"] for p in pts]
+    w1 = [p["dW1_over_L"] for p in pts]
+    w2 = [p["dW2_over_L"] for p in pts]
+    top = [shear_limit(1.0, w, compression) for w in x]
+    ax.fill_between(x, 0.0, w1, color=PHASE_COLOURS["U"], lw=0)
+    ax.fill_between(x, w1, w2, color=PHASE_COLOURS["US"], lw=0)
+    ax.fill_between(x, w2, top, color=PHASE_COLOURS["S"], lw=0)
+    i = len(x) // 2
+    for text, y in (("U", 0.5 * w1[i]), ("US", 0.5 * (w1[i] + w2[i])), ("S", 0.5 * (w2[i] + top[i]))):
+        ax.text(x[i], y, text, ha="center", va="center", fontsize=11, color="0.35")
+
+
+def _caption(rows, usable, gold, panels) -> str:
+    runs = len(rows)
+    missing = runs - len(usable)
+    text = (f"Thresholds of {runs} run{'s' * (runs != 1)} (sweep.csv): dW1/L (filled, solid) where the U branch "
+            "loses stability, dW2/L (open, dashed) where the stable path reaches S; grey: dW_max/L (Eq. B.1); "
+            "shading: the phases of the first curve.")
+    if missing:
+        text += (f" {missing} run{'s' * (missing != 1)} located neither threshold and "
+                 f"{'are' if missing != 1 else 'is'} not drawn.")
+    shown = [g for g in gold if _near(g["dL_over_L"], panels)]
+    if not shown:
+        return text + " No FEM gold data for these dL/L (data/fem_gold): no reference points, no error bars."
+    with_bars = [g for g in shown if g["dW1_error"] is not None or g["dW2_error"] is not None]
+    text += (f" Black: the FEM shell's gold thresholds (data/fem_gold, {len(shown)} scenes at the paper's "
+             "thickness b = 0.127 mm)")
+    if with_bars:
+        bars = "; ".join(f"{g['scene']}: dW1 +/-{_fmt(g['dW1_error'])}, dW2 +/-{_fmt(g['dW2_error'])}"
+                         for g in with_bars)
+        text += (f", with error bars from their mesh-convergence estimate (Richardson, data/fem_convergence) "
+                 f"where one exists ({bars})")
+    rest = len(shown) - len(with_bars)
+    if rest:
+        text += (f"; {'the other ' if with_bars else ''}{rest} scene{'s' * (rest != 1)} "
+                 f"{'have' if rest != 1 else 'has'} no error estimate and no error bar")
+    return text + "."
+
+
+def _spread(values: list[float], lo: float, hi: float, logx: bool) -> list[float]:
+    """The values to label on the W/L axis, at least 8 % of the axis apart (the first kept)."""
+    scale = (lambda v: math.log(v)) if logx else (lambda v: v)
+    gap = 0.08 * (scale(hi) - scale(lo)) if hi > lo else 0.0
+    kept: list[float] = []
+    for v in values:
+        if not kept or scale(v) - scale(kept[-1]) >= gap:
+            kept.append(v)
+    return kept
+
+
+def _near(value, panels) -> bool:
+    return any(abs(value - p) < 1e-9 for p in panels)
+
+
+def _span(lo: float, hi: float, logx: bool, n: int = 60) -> list[float]:
+    if hi <= lo:
+        return [lo, hi]
+    if logx:
+        return [lo * (hi / lo) ** (i / (n - 1)) for i in range(n)]
+    return [lo + (hi - lo) * i / (n - 1) for i in range(n)]
+
+
+def _fmt(value) -> str:
+    return "?" if value is None else f"{value:.2g}"
+
+
+def _number(text):
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        return None
+    return value if math.isfinite(value) else None

@@ -68,7 +68,7 @@ def test_sweep_tables_every_run_as_a_direct_simulate_and_a_rerun_computes_nothin
     assert main(SMALL_GRID + ["--workers", "2", "--out", str(tmp_path)]) == 0
     assert time.perf_counter() - t0 < 5.0
     out = capsys.readouterr().out
-    assert "2 runs on nothing to compute: 0 computed, 2 cached, 0 failed" in out, out
+    assert "sweep: 2 runs: 0 computed, 2 cached, 0 failed" in out, out
     assert (tmp_path / "sweep.csv").read_text() == before
 
 
@@ -176,7 +176,7 @@ def test_a_worker_killed_during_a_run_loses_that_run_only(tmp_path, scheduler):
     assert not outcome.errors, outcome.errors
     killed = json.loads((tmp_path / "runs" / "killed.json").read_text())
     assert killed["rows"] >= 5 and killed["pid"] != os.getpid()
-    assert outcome.interrupted is None and not outcome.errors and outcome.where.startswith("the scheduler at ")
+    assert outcome.interrupted is None and outcome.where.startswith("the scheduler at ")
     assert set(outcome.results) == set(specs) and outcome.retried == [specs[1]]
     for spec in specs:
         expected = direct(spec.width_ratio)

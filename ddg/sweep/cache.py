@@ -41,7 +41,8 @@ class Outcome:
     """What run_cached did: `results` every finished run (from the cache or computed now),
     `computed` the runs computed now, `errors` spec -> message of the runs that raised or whose
     task failed, `retried` the runs whose earlier attempt had been killed, `interrupted` the
-    KeyboardInterrupt that stopped it (None if it ran to the end), `where` what ran the tasks."""
+    KeyboardInterrupt that stopped it (None if it ran to the end), `where` what ran the tasks
+    ("" if every run was cached)."""
 
     results: dict[RunSpec, RunResult] = field(default_factory=dict)
     directories: dict[RunSpec, Path] = field(default_factory=dict)
@@ -51,7 +52,7 @@ class Outcome:
     errors: dict[RunSpec, str] = field(default_factory=dict)
     retried: list[RunSpec] = field(default_factory=list)
     interrupted: BaseException | None = None
-    where: str = "nothing to compute"
+    where: str = ""
     wall_time_s: float = 0.0
 
 

@@ -97,9 +97,9 @@ def main(args) -> int:
                          "stopped); the run was redone\n")
     files = ", ".join(str(p) for p in written + figures)
     if not args.quiet:
-        print(f"sweep: {len(specs)} runs on {outcome.where}: {len(outcome.computed)} computed, "
-              f"{len(outcome.cached)} cached, {len(outcome.errors)} failed, in {outcome.wall_time_s:.1f} s; "
-              f"wrote {files}")
+        where = f" on {outcome.where}" if outcome.where else ""
+        print(f"sweep: {len(specs)} runs: {len(outcome.computed)} computed{where}, {len(outcome.cached)} cached, "
+              f"{len(outcome.errors)} failed, in {outcome.wall_time_s:.1f} s; wrote {files}")
     if outcome.interrupted is not None:
         done = len(outcome.results)
         sys.stderr.write(f"error: interrupted by {signal_name_of(outcome.interrupted)}: {done} of {len(specs)} runs "

@@ -74,7 +74,7 @@ def write_table(out, rows: list[dict]) -> list[Path]:
     table = pyarrow.Table.from_pydict({c: [_typed(r.get(c), TYPES.get(c, FLOAT)) for r in rows] for c in COLUMNS},
                                       schema=schema)
     tmp = parquet.with_name(".sweep.parquet.tmp")
-    pyarrow.parquet.write_table(table, tmp)
+    pyarrow.parquet.write_table(table, str(tmp))
     tmp.replace(parquet)
     written.append(parquet)
     return written

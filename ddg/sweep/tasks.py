@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import socket
 import tempfile
 import time
@@ -127,8 +128,9 @@ def materialise(record: dict, directory) -> None:
     files = record.pop("files", None)
     if files is None:
         return
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / FINISHED).unlink(missing_ok=True)
+    if directory.exists():  # what an earlier, unfinished attempt left
+        shutil.rmtree(directory)
+    directory.mkdir(parents=True)
     for name, data in files.items():
         path = directory / name
         path.parent.mkdir(parents=True, exist_ok=True)

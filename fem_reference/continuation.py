@@ -101,6 +101,9 @@ class Stepper:
         #: not; None: the path's own load steps ("accepted steps", "rejected steps", "fold snaps")
         self.phase: str | None = None
         self.step_halvings = 0  # substeps halved after failing (all phases)
+        #: load of the last substep that failed below min_substep (set when advance raises
+        #: ContinuationFailure; the model is then at the last converged state, self.load)
+        self.failed_load: np.ndarray | None = None
         self.snaps = 0  # substeps that converged by energy descent past a fold (all phases)
 
     def iteration_breakdown(self) -> dict:
@@ -179,6 +182,7 @@ class Stepper:
                 self.substep = size / 2.0
                 self.step_halvings += 1
                 if self.substep < self.options.min_substep:
+                    self.failed_load = np.array(trial)
                     raise ContinuationFailure(
                         f"load step below {self.options.min_substep:g} L without convergence from "
                         f"dL/L = {current[0]:.6f}, dW/L = {current[1]:.6f}")
@@ -401,23 +405,35 @@ def locate_dw2(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW2
     The US branch either reaches S continuously (the phase at the bisection point decides) or
     ends in a fold, past which Newton from the US side cannot converge: the stable path snaps to
     S there, so a failed step also counts as past dW2. No energy descent during the bisection
-    (on the shell it takes hundreds of Levenberg-Marquardt steps per snap)."""
+    (on the shell it takes hundreds of Levenberg-Marquardt steps per snap).
+
+    A failed advance still tells where US ends: it converged on US up to the load it stopped at
+    and failed on the substep after it, narrower than 2 min_substep, so that substep is the new
+    bracket (min_substep = tol/8 here: the bracket closes without further bisection). Newton
+    gives up once its residual has stalled for 6 iterations (NewtonOptions.stall_window) instead
+    of running to max_iterations: past the fold it oscillates between two residual levels."""
     load_a, state_a, history_a = low
     a, b = float(load_a[1]), float(high_shear)
-    iterations = 0
-    saved = stepper.options
-    stepper.options = replace(saved, snap_substep=0.0, min_substep=max(saved.min_substep, 1e-2 * tol))
+    solver = stepper.solver
+    before = solver.iterations_by_phase["threshold dW2"]
+    saved, saved_newton = stepper.options, solver.options
+    stepper.options = replace(saved, snap_substep=0.0, min_substep=max(saved.min_substep, tol / 8.0))
+    solver.options = replace(saved_newton, stall_window=6)
     saved_phase, stepper.phase = stepper.phase, "threshold dW2"
     try:
         while b - a > tol:
             mid = 0.5 * (a + b)
             stepper.restore(load_a, state_a, history_a)
             try:
-                stats = stepper.advance((load_a[0], mid))
+                stepper.advance((load_a[0], mid))
             except ContinuationFailure:
-                b = mid  # beyond the fold of US
+                b = min(mid, float(stepper.failed_load[1]))  # beyond the fold of US
+                reached = float(stepper.load[1])  # the model is at the last converged substep
+                if reached > a and phase_of(stepper.model, stepper.model.positions())[0].startswith("US"):
+                    a = reached
+                    load_a, state_a = np.array(stepper.load), stepper.model.get_state()
+                    history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
                 continue
-            iterations += stats.newton_iterations
             phase, _, _ = phase_of(stepper.model, stepper.model.positions())
             if phase.startswith("S"):
                 b = mid
@@ -426,6 +442,6 @@ def locate_dw2(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW2
                 load_a, state_a = np.array(stepper.load), stepper.model.get_state()
                 history_a = Branch(list(stepper.branch.loads), list(stepper.branch.states))
     finally:
-        stepper.options = saved
+        stepper.options, solver.options = saved, saved_newton
         stepper.phase = saved_phase
-    return b, iterations
+    return b, solver.iterations_by_phase["threshold dW2"] - before

@@ -213,10 +213,19 @@ def stability_map(rows: list[dict]):
 
 
 def snapshots(rows: list[dict], panels: list[dict]):
-    """3D shapes, one row of panels per width (matplotlib 3D; the frames also open in ParaView)."""
+    """3D shapes, one row of panels per width: rendered with pyvista (lit surfaces, one camera and
+    one colour scale for all panels, clamps drawn; ddg.output.render) when the render extra is
+    installed, else matplotlib 3D surfaces from the rows. The frames also open in ParaView."""
     plt = _pyplot()
     widths = sorted({p["width_ratio"] for p in panels})
     cols = max(sum(1 for p in panels if p["width_ratio"] == w) for w in widths)
+    rendered = _rendered_snapshots(panels, widths, cols)
+    if rendered is not None:
+        fig = plt.figure(figsize=(rendered.shape[1] / 110, rendered.shape[0] / 110))
+        ax = fig.add_axes([0, 0, 1, 1])
+        ax.imshow(rendered)
+        ax.set_axis_off()
+        return fig
     fig = plt.figure(figsize=(4.0 * cols, 3.0 * len(widths)))
     for i, width in enumerate(widths):
         for j, panel in enumerate([p for p in panels if p["width_ratio"] == width]):
@@ -235,6 +244,25 @@ def snapshots(rows: list[dict], panels: list[dict]):
             ax.tick_params(labelsize=6)
     fig.tight_layout()
     return fig
+
+
+def _rendered_snapshots(panels: list[dict], widths: list[float], cols: int):
+    """The panels drawn by pyvista as one RGB image, or None without the render extra."""
+    from ddg.geometry.strip import InputError
+
+    if any("frame" not in p for p in panels):
+        return None
+    try:
+        from ddg.output.render import render_grid
+
+        grid = []
+        for width in widths:
+            row = [(p["frame"], f"W/L = {fraction(width)}: {p['phase']}, dW/L = {p['dW_over_L']:.3f}")
+                   for p in panels if p["width_ratio"] == width]
+            grid += row + [None] * (cols - len(row))
+        return render_grid(grid, None, columns=cols)
+    except InputError:  # the render extra (pyvista) is not installed
+        return None
 
 
 DRAW = {"elastica": elastica, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,

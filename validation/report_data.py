@@ -501,7 +501,7 @@ def snapshot_data(results, profile) -> tuple[FigureData | None, Snapshots]:
             mesh = meshio.read(path)
             xyz = mesh.points / float(run.summary["scene"]["length"])
             panels.append({"compression_ratio": compression, "width_ratio": width, "phase": phase, "dW_over_L": dw,
-                           "triangles": mesh.cells_dict["triangle"]})
+                           "triangles": mesh.cells_dict["triangle"], "frame": str(path)})
             rows += [[compression, width, phase, dw, k, *map(float, p)] for k, p in enumerate(xyz)]
     figure = FigureData(
         "snapshots_3d", "snapshots",

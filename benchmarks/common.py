@@ -1,12 +1,12 @@
 """Shared parts of the benchmark scripts (rod_path, plate_path, plate_linear_algebra).
 
-- PathInstrument: the base of the run-time instrumentation of one ddg.simulate run. It keeps
-  the monkeypatches (and undoes them in restore()), and counts the Newton solves (wrapping
-  ddg.solve.continuation.newton: caller, iterations, converged) and the recorded continuation
-  steps (wrapping PathFollower.advance / start_compression: load, time, solves). The scripts
-  subclass it with their own timers (which functions, how they are grouped).
-- timed_simulate: one instrumented, timed ddg.simulate call; path_timing: the record fields
-  every path run has; newton_by_caller / stage_summary: aggregates of the counters.
+- measurement through the library's public hooks only (no patching): PathProbe, a
+  ddg.solve.probe.Probe that records every Newton solve of the path (phase, iterations,
+  converged) and every recorded step with its wall time; measure_path: the first call, a warm
+  call with the probe (the wall time reported) and a separate warm call under cProfile;
+  CallGraph / category_split: the time of categories of functions (their outermost calls: a
+  category's call inside another's counts once, for the outer one) from cProfile's caller data,
+  scaled to the un-profiled wall time; path_timing: the record fields every path run has.
 - run_in_child / best_of: one run in a fresh (spawned) process with a timeout, and the best of
   --repeat such runs.
 - provenance: machine info (optionally the BLAS/LAPACK libraries), ddg source fingerprint,
@@ -14,15 +14,15 @@
 - reporting: fit_slope / path_slopes, text and markdown tables, the common report lines,
   write_report (atomic JSON + markdown).
 
-Nothing here is specific to one model; the library is not modified (patches are made at run
-time, in the benchmark's own child process only).
+Nothing here is specific to one model, and nothing touches the library's objects: the numbers
+come from the probe, summary.json and cProfile.
 """
 from __future__ import annotations
 
 import argparse
 import contextlib
+import cProfile
 import datetime as _dt
-import functools
 import hashlib
 import importlib
 import inspect
@@ -32,14 +32,18 @@ import math
 import multiprocessing as mp
 import os
 import platform
+import pstats
 import sys
 import time
 import traceback
 from collections import defaultdict
+from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
 from ddg.output.io import atomic_write_text
+from ddg.solve.continuation import PHASES
+from ddg.solve.probe import Probe
 
 CHANGED_NOTE = " (CHANGED during the run: runs may mix library versions)"
 
@@ -57,143 +61,298 @@ def tally(acc: dict, iterations: int, converged: bool,
         acc[its_failed] += iterations
 
 
-class PathInstrument:
-    """Patches installed around one run and removed by restore(), with the Newton-solve and
-    recorded-step counters of the path benchmarks. Subclasses define install()."""
+#: The phase of the path follower's solves that leave unstable states (a step's "branch_solves").
+BRANCH_PHASE = "branch switching"
+_STEP_COUNTERS = ("newton_solves", "iterations_all", "failed_solves", "iterations_failed")
+
+
+def _solve_counters(names=("solves", "iterations", "failed", "iterations_failed")) -> dict:
+    return dict.fromkeys(names, 0)
+
+
+class PathProbe(Probe):
+    """What the path benchmarks read of a run through its public timing/callback interface
+    (ddg.solve.probe): every Newton solve of the path follower (phase, iterations, converged) and
+    every recorded step with its wall time and the solves made to reach it."""
 
     def __init__(self):
-        self.newton_calls: list[dict] = []
+        self.solves: list[tuple[str, int, bool]] = []
         self.steps: list[dict] = []
-        self._current_step: dict | None = None
-        self._patches: list[tuple[object, str, object]] = []
+        self._next = {**_solve_counters(_STEP_COUNTERS), "branch_solves": 0}
 
-    def _set(self, owner, name: str, replacement) -> None:
-        self._patches.append((owner, name, getattr(owner, name) if isinstance(owner, type(sys))
-                              else owner.__dict__[name]))
-        setattr(owner, name, replacement)
+    def solve(self, phase: str, iterations: int, converged: bool) -> None:
+        self.solves.append((phase, int(iterations), bool(converged)))
+        tally(self._next, int(iterations), bool(converged), _STEP_COUNTERS)
+        if phase == BRANCH_PHASE:
+            self._next["branch_solves"] += 1
 
-    def restore(self) -> None:
-        while self._patches:
-            owner, name, original = self._patches.pop()
-            setattr(owner, name, original)
+    def step(self, stage: str, row: dict, wall_s: float) -> None:
+        self.steps.append({"stage": stage, "dL_over_L": float(row["dL_over_L"]), "dW_over_L": float(row["dW_over_L"]),
+                           **self._next, "time_s": float(wall_s)})
+        self._next = {**_solve_counters(_STEP_COUNTERS), "branch_solves": 0}
 
-    def install_path_counters(self, branch_callers: tuple[str, ...] | None = None, required: bool = False) -> None:
-        """Count the Newton solves (self.newton_calls) and time the recorded steps (self.steps).
+    def by_phase(self) -> dict:
+        """Newton solves, iterations, failed solves and iterations in them per phase (PHASES order)."""
+        out = {phase: _solve_counters() for phase in PHASES}
+        for phase, iterations, converged in self.solves:
+            tally(out.setdefault(phase, _solve_counters()), iterations, converged)
+        return out
 
-        branch_callers: callers whose solves count as branch solves of the step (the step then
-        has a "branch_solves" entry); required: fail if a PathFollower step method is missing
-        (otherwise it is not wrapped)."""
-        from ddg.solve import continuation
+    def stage_summary(self) -> dict:
+        """Wall time, iterations and failed solves of the compression steps and of the shear steps."""
+        return {stage: {"time_s": sum(st["time_s"] for st in self.steps if st["stage"] == stage),
+                        "iterations": sum(st["iterations_all"] for st in self.steps if st["stage"] == stage),
+                        "failed_solves": sum(st["failed_solves"] for st in self.steps if st["stage"] == stage)}
+                for stage in ("compression", "shear")}
 
-        inst = self
-        newton = continuation.__dict__["newton"]
-
-        @functools.wraps(newton)
-        def newton_counting(model, q, *args, **kwargs):
-            caller = sys._getframe(1).f_code.co_name
-            result = newton(model, q, *args, **kwargs)
-            rec = {"caller": caller, "iterations": int(result.iterations), "converged": bool(result.converged),
-                   "minimize": bool(kwargs.get("minimize", False))}
-            inst.newton_calls.append(rec)
-            step = inst._current_step
-            if step is not None:
-                tally(step, rec["iterations"], rec["converged"],
-                      ("newton_solves", "iterations_all", "failed_solves", "iterations_failed"))
-                if branch_callers is not None and caller in branch_callers:
-                    step["branch_solves"] += 1
-            return result
-
-        self._set(continuation, "newton", newton_counting)
-
-        PF = continuation.PathFollower
-
-        def stepper(name):
-            original = PF.__dict__[name]
-            sig = inspect.signature(original)
-
-            @functools.wraps(original)
-            def wrapper(self_, *args, **kwargs):
-                L = self_.model.strip.length
-                try:
-                    bound = sig.bind(self_, *args, **kwargs).arguments
-                    compression, shear = float(bound.get("compression", math.nan)), float(bound.get("shear", 0.0))
-                except (TypeError, ValueError):
-                    compression, shear = math.nan, math.nan
-                step = {"dL_over_L": compression / L, "dW_over_L": shear / L, "newton_solves": 0,
-                        "iterations_all": 0, "failed_solves": 0, "iterations_failed": 0}
-                if branch_callers is not None:
-                    step["branch_solves"] = 0
-                inst._current_step = step
-                t0 = time.perf_counter()
-                try:
-                    return original(self_, *args, **kwargs)
-                finally:
-                    step["time_s"] = time.perf_counter() - t0
-                    inst._current_step = None
-                    inst.steps.append(step)
-
-            return wrapper
-
-        for name in ("advance", "start_compression"):
-            if name in PF.__dict__ or required:
-                self._set(PF, name, stepper(name))
+    def matches(self, summary: dict) -> bool:
+        """The solves add up to summary.json's newton_iterations, phase by phase."""
+        by_phase = summary.get("newton_iterations_by_phase") or {}
+        return (sum(its for _, its, _ in self.solves) == summary["newton_iterations"]
+                and all(v["iterations"] == by_phase.get(k, 0) for k, v in self.by_phase().items()))
 
 
-def timed_simulate(inst: PathInstrument, strip, protocol, model: str, resolution: int):
-    """ddg.simulate twice in this (fresh) process: first uninstrumented, timed as the first call
-    (it loads the compiled kernels from numba's cache and the lazily imported modules), then with
-    inst installed (and restored afterwards), timed as the warm call. Returns (warm result, wall s,
-    cpu s); result.timings holds {"first_call_wall_s", "first_call_cpu_s"}."""
+def function_key(fn) -> tuple[str, int, str]:
+    """The key cProfile and pstats give a Python function: (file, first line, name)."""
+    code = inspect.unwrap(fn).__code__
+    return code.co_filename, code.co_firstlineno, code.co_name
+
+
+class Attribution:
+    """A profiled call's time and calls per function, split by the context they were made in
+    (CallGraph.attribute): per level, the label of the outermost enclosing call of that level's
+    functions, or None."""
+
+    def __init__(self, levels: list[dict], time_in: dict, calls_in: dict):
+        self.levels, self.time_in, self.calls_in = levels, time_in, calls_in
+
+    @staticmethod
+    def _key(fn):
+        return fn if isinstance(fn, tuple) else function_key(fn)
+
+    def time(self, fn) -> dict:
+        """{caller context: s} of fn's calls."""
+        return self.time_in.get(self._key(fn), {})
+
+    def calls(self, fn) -> dict:
+        """{caller context: calls} of fn."""
+        return self.calls_in.get(self._key(fn), {})
+
+    def outermost(self, label: str, level: int = 0, where: dict | None = None) -> float:
+        """Time of the calls of the functions labelled `label` (in levels[level]) made outside any
+        call of that level's functions, and (where = {level: label}) inside those of other levels."""
+        where = where or {}
+        return sum(t for f, lab in self.levels[level].items() if lab == label
+                   for ctx, t in self.time_in.get(f, {}).items()
+                   if ctx[level] is None and all(ctx[i] == w for i, w in where.items()))
+
+    def by_context(self, fn, level: int = 0) -> dict:
+        """{enclosing label or "top": {"calls", "time_s"}} of fn's calls (the other levels summed)."""
+        out: dict = {}
+        for source, field in ((self.calls(fn), "calls"), (self.time(fn), "time_s")):
+            for ctx, v in source.items():
+                slot = out.setdefault(ctx[level] or "top", {"calls": 0, "time_s": 0.0})
+                slot[field] += v
+        for slot in out.values():
+            slot["calls"] = round(slot["calls"])
+        return out
+
+
+class CallGraph:
+    """The call graph of one cProfile run (pstats data: per function its calls, own and cumulative
+    time, and per caller the calls and cumulative time made from that caller).
+
+    cProfile keeps one level of callers, not whole stacks; attribute() walks the graph from its
+    roots and splits every function's calls and time by the context they were made in, so that a
+    category's time inside another category's call counts once, for the outer one. A function
+    called from several contexts passes its callees' time on in proportion to its own time in each
+    (gprof's assumption); where a caller is only ever called in one context (the Lanczos operator
+    inside lowest_eigenpairs, Newton outside every category) the split is exact. Compiled (numba)
+    kernels are not Python calls for cProfile: their time is the own time of their caller."""
+
+    def __init__(self, stats: dict):
+        self.stats = stats
+
+    @classmethod
+    def of(cls, profile: cProfile.Profile) -> "CallGraph":
+        return cls(pstats.Stats(profile).stats)
+
+    def row(self, fn) -> tuple:
+        """(primitive calls, calls, own s, cumulative s) of fn; zeros if it was not called."""
+        row = self.stats.get(fn if isinstance(fn, tuple) else function_key(fn))
+        return tuple(row[:4]) if row else (0, 0, 0.0, 0.0)
+
+    def attribute(self, levels: list[dict]) -> Attribution:
+        """levels: dicts {function key: label}; a call of a labelled function opens its label's
+        context on its level unless a call of that level is already open (the outermost wins)."""
+        stats = self.stats
+        none = (None,) * len(levels)
+        callers = {f: {c: e for c, e in row[4].items() if c != f and c in stats} for f, row in stats.items()}
+        callees = defaultdict(list)
+        for f, cs in callers.items():
+            for c in cs:
+                callees[c].append(f)
+        order = _topological(list(stats), callers, callees)
+
+        def enter(f, ctx):
+            return tuple(level.get(f) if cur is None else cur for cur, level in zip(ctx, levels))
+
+        found = []
+        for edge, own in ((3, 3), (0, 1)):  # (edge, row) index: cumulative time, then calls
+            inside = {f: {enter(f, none): 1.0} for f in stats}  # context within f's calls (fractions)
+            absolute: dict = {}
+            for _ in range(100):
+                change = 0.0
+                for f in order:
+                    acc: dict = defaultdict(float)
+                    for c, e in callers[f].items():
+                        for ctx, p in inside[c].items():
+                            acc[ctx] += e[edge] * p
+                    total = sum(acc.values())
+                    if total <= 0.0:  # a root, or calls too short for the clock
+                        acc, total = {none: float(stats[f][own])}, float(stats[f][own])
+                    absolute[f] = dict(acc)
+                    new: dict = defaultdict(float)
+                    for ctx, v in acc.items():
+                        new[enter(f, ctx)] += v / total if total > 0.0 else 1.0 / len(acc)
+                    old = inside[f]
+                    change = max([change] + [abs(new[k] - old.get(k, 0.0)) for k in new]
+                                 + [abs(old[k]) for k in old if k not in new])
+                    inside[f] = dict(new)
+                if change < 1e-12:
+                    break
+            found.append(absolute)
+        return Attribution(levels, found[0], found[1])
+
+
+def _topological(nodes: list, callers: dict, callees: dict) -> list:
+    """Callers before callees (reverse DFS post-order from the roots; cycles broken anywhere)."""
+    seen, post = set(), []
+    roots = [n for n in nodes if not callers[n]] + nodes
+    for root in roots:
+        if root in seen:
+            continue
+        seen.add(root)
+        stack = [(root, iter(callees.get(root, ())))]
+        while stack:
+            node, it = stack[-1]
+            nxt = next((c for c in it if c not in seen), None)
+            if nxt is None:
+                post.append(node)
+                stack.pop()
+            else:
+                seen.add(nxt)
+                stack.append((nxt, iter(callees.get(nxt, ()))))
+    return post[::-1]
+
+
+def profiled(fn, *args, **kwargs):
+    """fn(*args, **kwargs) under cProfile: (its result, CallGraph, wall s including the profiler's overhead)."""
+    profile = cProfile.Profile()
+    t0 = time.perf_counter()
+    profile.enable()
+    try:
+        result = fn(*args, **kwargs)
+    finally:
+        profile.disable()
+    return result, CallGraph.of(profile), time.perf_counter() - t0
+
+
+@dataclass
+class PathMeasurement:
+    """The three simulate calls of measure_path."""
+    result: object                 # the warm call's SimulationResult
+    wall_s: float
+    cpu_s: float
+    first_call_wall_s: float
+    first_call_cpu_s: float
+    probe: PathProbe               # the warm call's solves and recorded steps
+    graph: CallGraph               # the profiled call's
+    profiled_wall_s: float
+    profiled_summary: dict
+
+
+def measure_path(strip, protocol, model: str, resolution: int, **options) -> PathMeasurement:
+    """ddg.simulate three times in this (fresh) process: the first, timed as the first call (it
+    loads the compiled kernels from numba's cache and the lazily imported modules); the second,
+    warm, with a PathProbe, timed as the run's wall and CPU time; the third under cProfile, for
+    the split of the time (cProfile's overhead stays out of the second call's wall time)."""
     import ddg
 
+    def run(**extra):
+        return ddg.simulate(strip, protocol, model=model, resolution=resolution, **options, **extra)
+
     c0, t0 = time.process_time(), time.perf_counter()
-    ddg.simulate(strip, protocol, model=model, resolution=resolution)
-    first = {"first_call_wall_s": time.perf_counter() - t0, "first_call_cpu_s": time.process_time() - c0}
-    inst.install()
-    try:
-        c0, t0 = time.process_time(), time.perf_counter()
-        result = ddg.simulate(strip, protocol, model=model, resolution=resolution)
-        wall = time.perf_counter() - t0
-        cpu = time.process_time() - c0
-    finally:
-        inst.restore()
-    result.timings = first
-    return result, wall, cpu
+    run()
+    first_wall, first_cpu = time.perf_counter() - t0, time.process_time() - c0
+    probe = PathProbe()
+    c0, t0 = time.process_time(), time.perf_counter()
+    result = run(probe=probe)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    again, graph, profiled_wall = profiled(run)
+    return PathMeasurement(result, wall, cpu, first_wall, first_cpu, probe, graph, profiled_wall, again.summary)
 
 
-def path_timing(result, wall: float, cpu: float) -> dict:
-    """The timing and size fields of one path run's record."""
-    s, rows = result.summary, result.rows
+def category_split(m: PathMeasurement, categories: dict, extra=None) -> tuple[dict, Attribution]:
+    """The split of the warm call's wall time between categories ({name: functions whose calls
+    are the category's entry points}) and "other": each category's outermost time under cProfile
+    (a call inside another category's call counts once, for the outer one) as a share of the
+    profiled wall time, times the un-profiled wall time. extra(attribution): more {name: seconds
+    under cProfile}, scaled the same way (sub-splits). Returns (record fields, the attribution)."""
+    level = {function_key(f): name for name, fns in categories.items() for f in fns}
+    attr = m.graph.attribute([level])
+    profiled_s = {name: attr.outermost(name) for name in categories}
+    profiled_s["other"] = m.profiled_wall_s - sum(profiled_s.values())
+    if extra is not None:
+        profiled_s.update(extra(attr))
+    scale = m.wall_s / m.profiled_wall_s if m.profiled_wall_s > 0 else math.nan
+    split = {k: v * scale for k, v in profiled_s.items()}
+    return {
+        "split_s": split,
+        "split_fraction": {k: v / m.wall_s for k, v in split.items()},
+        "split_profiled_s": profiled_s,
+        "profiled_wall_time_s": m.profiled_wall_s,
+        "split_method": "cProfile: outermost calls of the category entry points in a separate warm call, as shares "
+                        "of its wall time, scaled to the un-profiled wall time",
+    }, attr
+
+
+def path_timing(m: PathMeasurement) -> dict:
+    """The timing, size and Newton fields every path run's record has (the probe's and the summary's)."""
+    s, rows = m.result.summary, m.result.rows
     its = int(s["newton_iterations"])
     return {
-        "wall_time_s": wall,
-        "cpu_time_s": cpu,
-        **getattr(result, "timings", {}),
+        "wall_time_s": m.wall_s,
+        "cpu_time_s": m.cpu_s,
+        "first_call_wall_s": m.first_call_wall_s,
+        "first_call_cpu_s": m.first_call_cpu_s,
+        "profiled_wall_time_s": m.profiled_wall_s,
         "library_wall_time_s": s.get("wall_time_s"),
         "newton_iterations": its,
-        "time_per_newton_iteration_ms": 1e3 * wall / its if its else None,
+        "newton_iterations_by_phase": s.get("newton_iterations_by_phase"),
+        "profiled_run_newton_iterations": m.profiled_summary.get("newton_iterations"),
+        "threshold_newton_iterations": s.get("threshold_newton_iterations"),
+        "threshold_wall_time_s": s.get("threshold_wall_time_s"),
+        "branches_newton_iterations": s.get("branches_newton_iterations"),
+        "branches_wall_time_s": s.get("branches_wall_time_s"),
+        "time_per_newton_iteration_ms": 1e3 * m.wall_s / its if its else None,
         "recorded_steps": len(rows),
         "recorded_shear_steps": sum(1 for r in rows if r["stage"] == "shear"),
+        "newton_by_phase": m.probe.by_phase(),
+        "probe_matches_summary": m.probe.matches(s),
+        "stage": m.probe.stage_summary(),
+        "steps": m.probe.steps,
     }
 
 
-def newton_by_caller(newton_calls: list[dict], label=lambda rec: rec["caller"]) -> dict:
-    """Newton solves, iterations and failures per caller (label(record))."""
-    by_caller = defaultdict(lambda: {"solves": 0, "iterations": 0, "failed": 0, "iterations_failed": 0})
-    for rec in newton_calls:
-        tally(by_caller[label(rec)], rec["iterations"], rec["converged"])
-    return dict(by_caller)
-
-
-def stage_summary(steps: list[dict]) -> dict:
-    """Time, iterations and failed solves of the compression steps (dW = 0) and the shear steps."""
-    comp_steps = [st for st in steps if st["dW_over_L"] == 0.0]
-    shear_steps = [st for st in steps if st["dW_over_L"] != 0.0]
-    return {
-        name: {"time_s": sum(st["time_s"] for st in group), "iterations": sum(st["iterations_all"] for st in group),
-               "failed_solves": sum(st["failed_solves"] for st in group)}
-        for name, group in (("compression", comp_steps), ("shear", shear_steps))
-    }
+def eigen_calls(attr: Attribution, functions: dict) -> dict:
+    """{label: {"calls", "time_s"}} of the eigenvalue functions named (under cProfile, unscaled)."""
+    out = {}
+    for label, fn in functions.items():
+        calls, t = sum(attr.calls(fn).values()), sum(attr.time(fn).values())
+        if calls:
+            out[label] = {"calls": round(calls), "time_s": t}
+    return out
 
 
 # ---------------------------------------------------------------------------- runs in a child process
@@ -435,20 +594,28 @@ def run_notes(results: list[dict], label, note) -> list[str]:
 
 
 def newton_notes(r: dict) -> tuple[str, int, str]:
-    """(the three most expensive recorded steps, iterations in failed solves, solves per caller)
-    of one path run, as text."""
-    nb = r["newton_by_caller"]
+    """(the three most expensive recorded steps, iterations in failed solves, solves per phase)
+    of one path run, as text (from the probe)."""
+    nb = r["newton_by_phase"]
     steps = sorted(r["steps"], key=lambda s: -s["iterations_all"])[:3]
     worst = ", ".join(f"dL/L={s['dL_over_L']:.3f} dW/L={s['dW_over_L']:.4f}: {s['iterations_all']} its, "
                       f"{s['time_s']:.2f} s ({s['newton_solves']} solves, {s['failed_solves']} failed)" for s in steps)
     failed = sum(b["iterations_failed"] for b in nb.values())
-    caller = ", ".join(f"{k} {v['solves']} solves/{v['iterations']} its" for k, v in sorted(nb.items()))
-    return worst, failed, caller
+    phase = ", ".join(f"{k} {v['solves']} solves/{v['iterations']} its" for k, v in nb.items() if v["solves"])
+    return worst, failed, phase
+
+
+def after_path_text(r: dict) -> str:
+    """Threshold location and branch tracing after the path (summary.json), as text."""
+    parts = [f"{name} {r.get(f'{key}_newton_iterations')} its / {fmt(r.get(f'{key}_wall_time_s'), '.2f')} s"
+             for name, key in (("threshold location", "threshold"), ("branch tracing", "branches"))
+             if r.get(f"{key}_newton_iterations") is not None or r.get(f"{key}_wall_time_s") is not None]
+    return ", ".join(parts) or "none"
 
 
 def eigen_paths_text(r: dict) -> str:
-    """Calls and time per path of lowest_eigenpairs in one run ("" if none)."""
-    paths = r["calls"]["lowest_eigenpairs_paths"]
+    """Calls and time (s under cProfile) of the eigenvalue functions in one run ("" if none)."""
+    paths = r["calls"]["eigen_calls"]
     return "; ".join(f"{k} {v['calls']} calls/{v['time_s']:.2f} s" for k, v in paths.items())
 
 

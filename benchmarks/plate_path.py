@@ -13,12 +13,11 @@ For each target triangle count N it runs
 in a fresh child process (so a run that exceeds --timeout can be stopped) and reports the actual
 triangle count and free DOFs, the Hessian bandwidth, the wall and CPU time (best of --repeat),
 Newton iterations, whether the path completed (and the library's message), the dW/L reached,
-the evaluations per Newton iteration (full Hessian, gradient only, energy only) and the split of
-the time per Newton iteration between
+the evaluations per Newton iteration and the split of the time per Newton iteration between
 
   (a) element evaluation + assembly: PlateModel.evaluate (compiled kernels that write straight
-      into the gradient and the band; not split further since issue 14);
-  (b) factorisation and solves: SymmetricBanded.cholesky / .solve and any direct call of
+      into the gradient and the band), with (a1) the kernels and (a3) the rest of evaluate;
+  (b) factorisation and solves: SymmetricBanded.cholesky / .solve / .ldlt and any direct call of
       scipy.linalg.cholesky_banded / cho_solve_banded / solve_banded (and scipy.sparse.linalg
       splu / spsolve / factorized, in case the library starts using them);
   (c) eigenvalue work: ddg.solve.stability.lowest_modes, SymmetricBanded.lowest_eigenpairs
@@ -26,15 +25,16 @@ the time per Newton iteration between
   (d) other: the rest of the wall time (Newton and continuation bookkeeping, predictors, band
       restriction and copies, observables, model and mesh set-up).
 
-Method: those functions are wrapped with timers at run time (time.perf_counter around each
-call), in the child process only, and restored afterwards; the library is not modified. A
-call made inside another timed call of categories (a)-(c) is counted once, by the outermost
-one: the Cholesky factorisations and Lanczos solves inside lowest_eigenpairs are eigenvalue
-work, a kernel call is counted inside (a). The kernels/assembly sub-split is taken the same
-way one level down (the outermost kernel or assembly call inside evaluate). Per-function
-inclusive times, split by the category of the enclosing call, are kept in the JSON
-("calls.by_function"). The wrappers cost ~1 us per call, negligible against the ms-scale
-calls they time.
+Method (benchmarks.common.measure_path; the library's public hooks only, nothing patched): the
+child calls simulate three times. The first call is timed as the first call; the second, warm,
+carries a ddg.solve.probe.Probe (every Newton solve of the path with its phase, every recorded
+step with its wall time) and is the wall time reported; the third runs under cProfile. A
+category's time is the time of its entry points' outermost calls there (a call made inside
+another category's call counts once, for the outer one: the Cholesky factorisations and Lanczos
+solves inside lowest_eigenpairs are eigenvalue work), as a share of the profiled call's wall time,
+scaled to the un-profiled wall time. The compiled kernels are not Python calls for cProfile: their
+time is PlateModel.evaluate's own time, reported as (a1). Per-function times by enclosing category
+are kept in the JSON ("calls.by_function", seconds under cProfile).
 
 Writes OUT/plate_path.json (all numbers, per-step detail and machine info) and OUT/plate_path.md
 (the tables), both atomically (ddg.output.io.atomic_write_text). Not part of the test run.
@@ -43,16 +43,12 @@ from __future__ import annotations
 
 import argparse
 import functools
-import importlib
-import inspect
 import sys
-import time
-from collections import defaultdict
 
-from benchmarks.common import (PathInstrument, Provenance, best_of, eigen_paths_text, finish_path_report, fit_slope,
-                               fmt, load_line, machine_section, newton_by_caller, newton_notes, path_slopes,
-                               path_timing, ratio, run_in_child, run_notes, section, slopes_markdown, slopes_text,
-                               source_fingerprint, stage_summary, table_section, text_table, timed_simulate)
+from benchmarks.common import (Provenance, after_path_text, best_of, category_split, eigen_calls, eigen_paths_text,
+                               finish_path_report, fit_slope, fmt, function_key, load_line, machine_section,
+                               measure_path, newton_notes, path_slopes, path_timing, ratio, run_in_child, run_notes,
+                               section, slopes_markdown, slopes_text, source_fingerprint, table_section, text_table)
 
 WIDTH_RATIO = 1.0 / 6.0
 COMPRESSION_RATIO = 0.5
@@ -62,13 +58,16 @@ TRIANGLES = [500, 1000, 2000, 4000]
 
 #: level 1: where the wall time goes; level 2: inside PlateModel.evaluate
 LEVEL1 = ("evaluate", "linalg", "eigen")
-LEVEL2 = ("kernels", "assembly")
+LEVEL2 = ("kernels",)
 CATEGORY_LABELS = {
     "evaluate": "(a) element evaluation + assembly (PlateModel.evaluate)",
-    "kernels": "(a1) energy/gradient/Hessian kernels (ddg.energies.* called by PlateModel.evaluate)",
-    "assembly": "(a2) band assembly (BandAssembler.assemble)",
-    "evaluate_rest": "(a3) rest of PlateModel.evaluate (gathers, edge vectors, gradient bincounts)",
-    "linalg": "(b) factorisation and solves (SymmetricBanded.cholesky, .solve; scipy cholesky_banded, "
+    "kernels": "(a1) energy/gradient/Hessian kernels: the compiled passes evaluate calls (ddg.energies add_edge_terms, "
+               "add_hinge_terms); cProfile does not see compiled calls, so this is evaluate's own time (its few "
+               "lines of Python included)",
+    "assembly": "(a2) band assembly: not a separate step since issue 14 (the kernels write into the band): n/a",
+    "evaluate_rest": "(a3) rest of PlateModel.evaluate (the Python calls it makes: accumulators, reshapes, the "
+                     "Evaluation)",
+    "linalg": "(b) factorisation and solves (SymmetricBanded.cholesky, .solve, .ldlt; scipy cholesky_banded, "
               "cho_solve_banded, solve_banded called directly)",
     "eigen": "(c) eigenvalue work (stability.lowest_modes, SymmetricBanded.lowest_eigenpairs, with their own "
              "factorisations and Lanczos solves)",
@@ -77,203 +76,95 @@ CATEGORY_LABELS = {
 }
 
 
-# ---------------------------------------------------------------------------- instrumentation
-class _Instrument(PathInstrument):
-    """Timing wrappers on the plate's library functions, installed and removed around one run."""
+# ---------------------------------------------------------------------------- what is timed
+def category_functions() -> dict:
+    """The entry points of each level-1 category: {category: functions}."""
+    import scipy.linalg
+    import scipy.sparse.linalg
 
-    def __init__(self):
-        super().__init__()
-        self.stack: list[tuple[str, str]] = []             # (key, category) of the timed calls in progress
-        self.level1 = defaultdict(float)                    # category -> time of outermost level-1 calls
-        self.level1_calls = defaultdict(int)
-        self.level2 = defaultdict(float)                    # (category, enclosing level-1 or "outside") -> time
-        self.level2_calls = defaultdict(int)
-        self.by_function = defaultdict(lambda: defaultdict(lambda: [0, 0.0]))  # key -> context -> [calls, s]
-        self.eval_kinds = defaultdict(lambda: [0, 0.0])     # "full" / "gradient" / "energy" -> [calls, s]
-        self.factorisations = defaultdict(lambda: defaultdict(int))  # context -> "ok"/"not PD" -> count
-        self.eigen_paths = defaultdict(lambda: [0, 0.0])
-        self.notes: list[str] = []
+    from ddg.models.plate import PlateModel
+    from ddg.solve.banded import SymmetricBanded as SB
+    from ddg.solve.stability import lowest_modes
 
-    # -- the timer
-    def _timed(self, key: str, category: str, original, after=None):
-        inst = self
+    sl, ssl = scipy.linalg, scipy.sparse.linalg
+    return {
+        "evaluate": [PlateModel.evaluate],
+        "linalg": [SB.cholesky, SB.solve, SB.ldlt, sl.cholesky_banded, sl.cho_solve_banded, sl.solve_banded,
+                   ssl.splu, ssl.spsolve, ssl.factorized],
+        "eigen": [lowest_modes, SB.lowest_eigenpairs, ssl.eigsh, sl.eig_banded, sl.eigvals_banded],
+    }
 
-        @functools.wraps(original)
-        def wrapper(*args, **kwargs):
-            stack = inst.stack
-            outer1 = next((c for _, c in stack if c in LEVEL1), None)
-            inside2 = any(c in LEVEL2 for _, c in stack)
-            recursive = any(k == key for k, _ in stack)
-            stack.append((key, category))
-            t0 = time.perf_counter()
-            try:
-                result = original(*args, **kwargs)
-            finally:
-                dt = time.perf_counter() - t0
-                stack.pop()
-                if not recursive:
-                    slot = inst.by_function[key][outer1 or "top"]
-                    slot[0] += 1
-                    slot[1] += dt
-                if category in LEVEL1 and outer1 is None:
-                    inst.level1[category] += dt
-                    inst.level1_calls[category] += 1
-                if category in LEVEL2 and not inside2:
-                    inst.level2[(category, outer1 or "outside")] += dt
-                    inst.level2_calls[(category, outer1 or "outside")] += 1
-            if after is not None:
-                after(args, kwargs, result, dt, outer1)
-            return result
 
-        wrapper.__wrapped_by_benchmark__ = True
-        return wrapper
+def _eigen_functions() -> dict:
+    import numpy as np
+    from scipy.sparse.linalg import eigsh
 
-    def _patch_method(self, cls, name: str, key: str, category: str, after=None, required=False) -> bool:
-        if name not in cls.__dict__:
-            if required:
-                raise RuntimeError(f"{cls.__name__}.{name} not found: the benchmark needs updating")
-            self.notes.append(f"{cls.__name__}.{name} not found; not timed")
-            return False
-        self._set(cls, name, self._timed(key, category, cls.__dict__[name], after))
-        return True
+    from ddg.solve.banded import SymmetricBanded as SB
+    from ddg.solve.lanczos import lowest_eigenvalue
+    from ddg.solve.stability import lowest_modes
 
-    def _patch_function(self, module, name: str, key: str, category: str) -> bool:
-        """Wrap module.name and every reference to the same function object in loaded ddg modules
-        (they import functions by name, e.g. `from .stability import lowest_modes`)."""
-        original = getattr(module, name, None)
-        if original is None or getattr(original, "__wrapped_by_benchmark__", False):
-            if original is None:
-                self.notes.append(f"{module.__name__}.{name} not found; not timed")
-            return False
-        wrapper = self._timed(key, category, original)
-        self._set(module, name, wrapper)
-        for mod_name, mod in list(sys.modules.items()):
-            if mod is module or mod is None or not (mod_name == "ddg" or mod_name.startswith("ddg.")):
-                continue
-            for attr, value in list(vars(mod).items()):
-                if value is original:
-                    self._set(mod, attr, wrapper)
-        return True
-
-    def install(self) -> None:
-        import scipy.linalg
-        import scipy.sparse.linalg
-
-        importlib.import_module("ddg.api")  # loads every module whose references are rebound below
-        from ddg.models import plate
-        from ddg.solve import banded, stability
-        from ddg.solve.banded import SymmetricBanded
-
-        inst = self
-
-        # (a) evaluate, with the kind of evaluation
-        evaluate = plate.PlateModel.__dict__["evaluate"]
-        signature = inspect.signature(evaluate)
-
-        def classify(args, kwargs, result, dt, outer1):
-            if outer1 is not None:
-                return
-            try:
-                bound = signature.bind(*args, **kwargs)
-                bound.apply_defaults()
-                grad, hess = bool(bound.arguments.get("gradient", True)), bool(bound.arguments.get("hessian", True))
-                kind = "full" if (grad and hess) else ("gradient" if grad else "energy")
-            except TypeError:
-                kind = "unknown"
-            inst.eval_kinds[kind][0] += 1
-            inst.eval_kinds[kind][1] += dt
-
-        self._patch_method(plate.PlateModel, "evaluate", "PlateModel.evaluate", "evaluate", classify, required=True)
-        # (a1) kernels: the ddg.energies functions the plate module calls
-        kernels = [name for name, value in vars(plate).items()
-                   if inspect.isfunction(value) and (value.__module__ or "").startswith("ddg.energies")]
-        for name in kernels:
-            self._patch_function(plate, name, f"{plate.__dict__[name].__module__}.{name}", "kernels")
-        if not kernels:
-            self.notes.append("no ddg.energies functions found in ddg.models.plate; kernel time not separated")
-        # (a2) assembly: since issue 14 the compiled kernels write straight into the band (no separate
-        # assembly step); the kernels are numba dispatchers, timed as a whole inside evaluate
-
-        # (b) factorisation and solves
-        chol = SymmetricBanded.__dict__["cholesky"]
-
-        @functools.wraps(chol)
-        def cholesky_counting(self_, *a, **k):
-            fresh = not getattr(self_, "_cholesky_tried", True)
-            out = chol(self_, *a, **k)
-            if fresh:
-                context = next((c for _, c in inst.stack[:-1] if c in LEVEL1), None) or "top"
-                inst.factorisations[context]["positive definite" if out else "not PD"] += 1
-            return out
-
-        self._set(SymmetricBanded, "cholesky", self._timed("SymmetricBanded.cholesky", "linalg", cholesky_counting))
-        self._patch_method(SymmetricBanded, "solve", "SymmetricBanded.solve", "linalg")
-        for name in ("cholesky_banded", "cho_solve_banded", "solve_banded"):
-            self._patch_function(scipy.linalg, name, f"scipy.linalg.{name}", "linalg")
-        for name in ("splu", "spsolve", "factorized"):
-            self._patch_function(scipy.sparse.linalg, name, f"scipy.sparse.linalg.{name}", "linalg")
-
-        # (c) eigenvalue work
-        self._patch_function(stability, "lowest_modes", "stability.lowest_modes", "eigen")
-
-        def eig_path(args, kwargs, result, dt, outer1):
-            self_ = args[0]
-            count = kwargs.get("count", args[1] if len(args) > 1 else 1)
-            vectors = kwargs.get("vectors", args[2] if len(args) > 2 else False)
-            if self_.n <= 4 * min(count, self_.n) + 20:
-                path = "dense eigh"
-            elif getattr(self_, "_cholesky", None) is not None:
-                path = "Lanczos on A^-1 (A positive definite)"
-            else:
-                path = "Lanczos on (A + sigma I)^-1 (A indefinite, shift search)"
-            path += ", with vectors" if vectors else ""
-            inst.eigen_paths[path][0] += 1
-            inst.eigen_paths[path][1] += dt
-
-        self._patch_method(SymmetricBanded, "lowest_eigenpairs", "SymmetricBanded.lowest_eigenpairs", "eigen", eig_path)
-        self._patch_function(scipy.sparse.linalg, "eigsh", "scipy.sparse.linalg.eigsh", "eigen")
-        self._patch_function(scipy.linalg, "eig_banded", "scipy.linalg.eig_banded", "eigen")
-        self._patch_function(scipy.linalg, "eigvals_banded", "scipy.linalg.eigvals_banded", "eigen")
-        del banded  # imported so its `sla` module attribute lookups see the patched scipy functions
-
-        # Newton solves (who called them, iterations, converged or not) and the recorded steps
-        self.install_path_counters()
+    return {"lowest_modes": lowest_modes, "compiled Lanczos on the Cholesky factor": lowest_eigenvalue,
+            "lowest_eigenpairs": SB.lowest_eigenpairs, "ARPACK eigsh": eigsh, "dense eigh": np.linalg.eigh}
 
 
 # ---------------------------------------------------------------------------- one run (child)
-def _run_once(triangles: int, config: dict) -> dict:
+def measure(triangles: int, config: dict) -> dict:
+    """The record of one N: the scene of config through measure_path, in this process."""
+    import scipy.linalg
+
     import ddg
+    from ddg.models.plate import PlateModel
+    from ddg.solve.band_ldlt import BandLDLT
+    from ddg.solve.banded import SymmetricBanded as SB
 
     fingerprint = source_fingerprint()
-    inst = _Instrument()
     strip = ddg.Strip.from_ratios(config["width_ratio"], COMPRESSION_RATIO)
     protocol = ddg.LoadingProtocol(COMPRESSION_RATIO, config["shear_ratio"],
                                    compression_steps=config["compression_steps"],
                                    shear_steps=config["shear_steps"])
-    result, wall, cpu = timed_simulate(inst, strip, protocol, "plate", triangles)
-
+    m = measure_path(strip, protocol, "plate", triangles)
+    result, wall = m.result, m.wall_s
     s = result.summary
     model = result.model
     rows = result.rows
     its = int(s["newton_iterations"])
+    fns = category_functions()
+    evaluate = PlateModel.evaluate
 
-    # level-1 split and the sub-split of evaluate
-    split = {c: inst.level1.get(c, 0.0) for c in LEVEL1}
-    split["other"] = wall - sum(split.values())
-    sub = {c: inst.level2.get((c, "evaluate"), 0.0) for c in LEVEL2}
-    sub["evaluate_rest"] = split["evaluate"] - sum(sub.values())
-    outside = {f"{c} outside evaluate": inst.level2[(c, ctx)] for (c, ctx) in inst.level2 if ctx != "evaluate"}
-    per_it = {k: (1e3 * v / its if its else None) for k, v in {**split, **sub}.items()}
-    # linear algebra: factorisation vs solves (outermost calls only)
-    fx = inst.by_function
+    def kernels(attr):
+        # the compiled kernels are evaluate's own time; its share of the calls made outside other categories
+        own, cumulative = m.graph.row(evaluate)[2], m.graph.row(evaluate)[3]
+        outer = attr.outermost("evaluate")
+        return {"kernels": own * (outer / cumulative if cumulative else 0.0)}
+
+    rec, attr = category_split(m, fns, kernels)
+    split = rec["split_s"]
+    split["evaluate_rest"] = split["evaluate"] - split["kernels"]
+    rec["split_fraction"] = {k: v / wall for k, v in split.items()}
+    scale = wall / m.profiled_wall_s
+    per_it = {k: (1e3 * v / its if its else None) for k, v in split.items()}
+
+    # factorisation vs solves (outermost calls), and the banded LU inside the solves
+    def outer(fn):
+        return scale * attr.time(fn).get((None,), 0.0)
+
     linalg_detail = {
-        "cholesky_s": fx["SymmetricBanded.cholesky"]["top"][1] if "SymmetricBanded.cholesky" in fx else 0.0,
-        "solve_s": fx["SymmetricBanded.solve"]["top"][1] if "SymmetricBanded.solve" in fx else 0.0,
-        "lu_solve_banded_inside_solve_s": fx["scipy.linalg.solve_banded"]["linalg"][1]
-        if "scipy.linalg.solve_banded" in fx else 0.0,
+        "cholesky_s": outer(SB.cholesky),
+        "solve_s": outer(SB.solve),
+        "ldlt_s": outer(SB.ldlt),
+        "lu_solve_banded_inside_solve_s": scale * attr.time(scipy.linalg.solve_banded).get(("linalg",), 0.0),
     }
-    evals = {k: {"calls": v[0], "time_s": v[1], "per_newton_iteration": v[0] / its if its else None,
-                 "ms_per_call": 1e3 * v[1] / v[0] if v[0] else None} for k, v in inst.eval_kinds.items()}
+    # factorisations by the category enclosing the SymmetricBanded.cholesky call that made them
+    no_cholesky = {function_key(f): c for c, fs in fns.items() for f in fs if f is not SB.cholesky}
+    around = m.graph.attribute([no_cholesky])
+    factorisations = {ctx: v["calls"] for ctx, v in around.by_context(scipy.linalg.cholesky_banded).items()}
+    total = round(sum(attr.calls(evaluate).values()))
+    with_hessian = round(sum(v for ctx, v in attr.calls(SB.__init__).items() if ctx == ("evaluate",)))
+    evals = {"total": total, "with_hessian": with_hessian, "without_hessian": total - with_hessian,
+             "per_newton_iteration": total / its if its else None,
+             "with_hessian_per_newton_iteration": with_hessian / its if its else None,
+             "without_hessian_per_newton_iteration": (total - with_hessian) / its if its else None,
+             "ms_per_call_all_kinds": 1e3 * split["evaluate"] / total if total else None}
     K = model.free_matrix(result.final_state.evaluation.hessian) if result.final_state is not None else None
     return {
         "triangles_target": triangles,
@@ -283,7 +174,7 @@ def _run_once(triangles: int, config: dict) -> dict:
         "n_dof": s.get("n_dof"),
         "n_free_dof": s.get("n_free_dof"),
         "bandwidth": int(K.band.shape[0] - 1) if K is not None else getattr(model, "bandwidth", None),
-        **path_timing(result, wall, cpu),
+        **path_timing(m),
         "completed": bool(s["converged"]),
         "message": s.get("message", ""),
         "dW_over_L_reached": float(rows[-1]["dW_over_L"]) if rows else None,
@@ -291,24 +182,19 @@ def _run_once(triangles: int, config: dict) -> dict:
         "dW1_over_L": s.get("dW1_over_L"),
         "dW2_over_L": s.get("dW2_over_L"),
         "H_mid_over_L_compressed": s.get("H_mid_over_L_compressed"),
-        "split_s": {**split, **sub, **outside},
-        "split_fraction": {k: v / wall for k, v in {**split, **sub}.items()},
+        **rec,
         "split_ms_per_newton_iteration": per_it,
         "linalg_detail": linalg_detail,
         "evaluations": evals,
-        "evaluations_total": sum(v[0] for v in inst.eval_kinds.values()),
         "calls": {
-            "level1": {c: {"calls": inst.level1_calls[c], "time_s": inst.level1[c]} for c in LEVEL1},
-            "by_function": {k: {ctx: {"calls": v[0], "time_s": v[1]} for ctx, v in d.items()} for k, d in fx.items()},
-            "cholesky_factorisations": {ctx: dict(d) for ctx, d in inst.factorisations.items()},
-            "lowest_eigenpairs_paths": {k: {"calls": v[0], "time_s": v[1]} for k, v in inst.eigen_paths.items()},
+            "by_function": {f"{fn.__module__}.{fn.__qualname__}": attr.by_context(fn)
+                            for fs in fns.values() for fn in fs if sum(attr.calls(fn).values())},
+            "cholesky_factorisations": factorisations,
+            "ldlt_factorisations": round(sum(attr.calls(BandLDLT.__init__).values())),
+            "eigen_calls": eigen_calls(attr, _eigen_functions()),
         },
-        "newton_by_caller": newton_by_caller(
-            inst.newton_calls, lambda rec: rec["caller"] + (" (minimize)" if rec["minimize"] else "")),
-        "stage": stage_summary(inst.steps),
-        "steps": inst.steps,
-        "branch_switches_dW_over_L": [r["dW_over_L"] for r in rows if r["stage"] == "shear" and r.get("branch_switched")],
-        "instrumentation_notes": inst.notes,
+        "branch_switches_dW_over_L": [r["dW_over_L"] for r in rows
+                                      if r["stage"] == "shear" and r.get("branch_switched")],
     }
 
 
@@ -317,6 +203,7 @@ RUN_HEADER = ("N target", "triangles", "free DOF", "band", "wall s", "cpu s", "N
               "dW/L reached", "steps", "full evals/it", "grad evals/it", "energy evals/it", "ms/full eval")
 SPLIT_HEADER = ("triangles", "eval ms/it", "kernels", "assembly", "eval rest", "factor+solve ms/it",
                 "eigen ms/it", "other ms/it", "eval %", "kernels %", "assembly %", "linalg %", "eig %", "other %")
+NA = "n/a"
 
 
 def _run_rows(results: list[dict]) -> list[tuple]:
@@ -326,18 +213,12 @@ def _run_rows(results: list[dict]) -> list[tuple]:
             out.append((str(r["triangles_target"]), "", r["status"]) + ("",) * (len(RUN_HEADER) - 3))
             continue
         ev = r["evaluations"]
-
-        def per_it(kind):
-            v = ev.get(kind, {}).get("per_newton_iteration")
-            return f"{v:.2f}" if v is not None else "0"
-
-        full_ms = ev.get("full", {}).get("ms_per_call")
         out.append((
             str(r["triangles_target"]), str(r["triangles"]), str(r["n_free_dof"]), str(r["bandwidth"]),
             f"{r['wall_time_s']:.2f}", f"{r['cpu_time_s']:.2f}", str(r["newton_iterations"]),
             fmt(r["time_per_newton_iteration_ms"], ".2f"), "yes" if r["completed"] else "NO",
             fmt(r["dW_over_L_reached"], ".4f") + (f" / {r['dW_max_over_L']:.4f}" if r.get("dW_max_over_L") else ""),
-            str(r["recorded_steps"]), per_it("full"), per_it("gradient"), per_it("energy"), fmt(full_ms, ".2f"),
+            str(r["recorded_steps"]), fmt(ev["with_hessian_per_newton_iteration"], ".2f"), NA, NA, NA,
         ))
     return out
 
@@ -349,9 +230,9 @@ def _split_rows(results: list[dict]) -> list[tuple]:
             continue
         p, f = r["split_ms_per_newton_iteration"], r["split_fraction"]
         out.append((
-            str(r["triangles"]), fmt(p["evaluate"], ".2f"), fmt(p["kernels"], ".2f"), fmt(p["assembly"], ".2f"),
+            str(r["triangles"]), fmt(p["evaluate"], ".2f"), fmt(p["kernels"], ".2f"), NA,
             fmt(p["evaluate_rest"], ".2f"), fmt(p["linalg"], ".2f"), fmt(p["eigen"], ".2f"), fmt(p["other"], ".2f"),
-            f"{100 * f['evaluate']:.0f}", f"{100 * f['kernels']:.0f}", f"{100 * f['assembly']:.0f}",
+            f"{100 * f['evaluate']:.0f}", f"{100 * f['kernels']:.0f}", NA,
             f"{100 * f['linalg']:.0f}", f"{100 * f['eigen']:.0f}", f"{100 * f['other']:.0f}",
         ))
     return out
@@ -370,25 +251,36 @@ def scaling(results: list[dict]) -> dict:
 
 def _run_note(r: dict) -> str:
     st = r["stage"]
-    worst, failed, caller = newton_notes(r)
+    worst, failed, phase = newton_notes(r)
     fac = r["calls"]["cholesky_factorisations"]
-    fac_txt = "; ".join(f"{ctx}: " + ", ".join(f"{n} {k}" for k, n in d.items()) for ctx, d in fac.items())
-    ld = r["linalg_detail"]
+    fac_txt = ", ".join(f"{ctx}: {n}" for ctx, n in fac.items())
+    ld, ev = r["linalg_detail"], r["evaluations"]
     return (
         f"N = {r['triangles_target']} ({r['triangles']} triangles): {r['message']!r}. Compression "
         f"{st['compression']['iterations']} its / {st['compression']['time_s']:.2f} s, shear "
         f"{st['shear']['iterations']} its / {st['shear']['time_s']:.2f} s; iterations in failed Newton solves "
-        f"{failed}; by caller: {caller}; most expensive recorded steps: {worst or 'none'}; branch switches at dW/L = "
-        f"{', '.join(f'{x:.4f}' for x in r['branch_switches_dW_over_L']) or 'none'}. Linear algebra: Cholesky "
-        f"{ld['cholesky_s']:.2f} s, solves {ld['solve_s']:.2f} s (of which banded LU on indefinite matrices "
-        f"{ld['lu_solve_banded_inside_solve_s']:.2f} s); Cholesky factorisations by context: {fac_txt or 'none'}. "
-        "Eigenvalue calls: " + (eigen_paths_text(r) or "none")
-        + "." + (f" Instrumentation notes: {'; '.join(r['instrumentation_notes'])}." if r["instrumentation_notes"] else "")
+        f"{failed}; by phase: {phase}; after the path: {after_path_text(r)}; most expensive recorded steps: "
+        f"{worst or 'none'}; branch switches at dW/L = "
+        f"{', '.join(f'{x:.4f}' for x in r['branch_switches_dW_over_L']) or 'none'}. Evaluations: "
+        f"{fmt(ev['per_newton_iteration'], '.2f')} per Newton iteration, "
+        f"{fmt(ev['with_hessian_per_newton_iteration'], '.2f')} with the Hessian and "
+        f"{fmt(ev['without_hessian_per_newton_iteration'], '.2f')} without (gradient or energy only), "
+        f"{fmt(ev['ms_per_call_all_kinds'], '.2f')} ms each on average over all kinds. Linear algebra "
+        f"(outermost calls, scaled): Cholesky {ld['cholesky_s']:.2f} s, solves {ld['solve_s']:.2f} s (of which "
+        f"banded LU on indefinite matrices {ld['lu_solve_banded_inside_solve_s']:.2f} s), LDL^T {ld['ldlt_s']:.2f} s; "
+        f"Cholesky factorisations by enclosing category: {fac_txt or 'none'}; LDL^T factorisations "
+        f"{r['calls']['ldlt_factorisations']}. Eigenvalue calls (s under cProfile): "
+        + (eigen_paths_text(r) or "none") + "."
     )
 
 
 def observations(results: list[dict]) -> list[str]:
     return run_notes(results, lambda r: f"N = {r['triangles_target']}", _run_note)
+
+
+def _overhead(results: list[dict]) -> str:
+    ratios = [r["profiled_wall_time_s"] / r["wall_time_s"] for r in results if r.get("status") == "ok"]
+    return f"{min(ratios):.2f}-{max(ratios):.2f}" if ratios else NA
 
 
 def markdown_report(report: dict) -> str:
@@ -405,33 +297,66 @@ def markdown_report(report: dict) -> str:
     lines += table_section(
         "Runs", RUN_HEADER, _run_rows(results),
         "triangles = `result.model.mesh.triangle_count`; free DOF = `summary['n_free_dof']`; band = bandwidth of the "
-        "free-DOF Hessian (lower band storage rows - 1); cpu s = CPU time of the child process during the run (above "
-        "the wall time when BLAS uses a second thread, below it when the process waited for a core); Newton its = "
-        "`summary['newton_iterations']` (including failed and branch-switching solves); complete = the path reached "
-        "its last load (the message is below); dW/L reached = the last recorded row / the largest asked. Evaluations "
-        "per Newton iteration: full = energy + gradient + Hessian (one per accepted step and one at the start of "
-        "each solve), grad = energy + gradient (line-search trials on indefinite Hessians), energy = energy only "
-        "(line-search trials after a rejected full step).")
+        "free-DOF Hessian (lower band storage rows - 1); wall s = the second, warm simulate call of the child, with a "
+        "`ddg.solve.probe.Probe` (no profiler, no patching; the first call, which loads the compiled kernels from "
+        "numba's cache, is `first_call_wall_s` in the JSON); cpu s = CPU time of the child process during the run "
+        "(above the wall time when BLAS uses a second thread, below it when the process waited for a core); Newton "
+        "its = `summary['newton_iterations']` (the path, including failed and branch-switching solves; threshold "
+        "location is counted apart, in the notes below); complete = the path reached its last load (the message is "
+        "below); dW/L reached = the last recorded row / the largest asked. full evals/it = evaluations with the "
+        "Hessian (energy + gradient + Hessian: one per accepted step and one at the start of each solve) per Newton "
+        "iteration, counted by cProfile as the SymmetricBanded Hessians built inside PlateModel.evaluate in the "
+        "profiled call (the same, deterministic path). **grad evals/it, energy evals/it and ms/full eval are n/a**: "
+        "the line search's trials without Hessian (energy + gradient on indefinite Hessians, energy only after a "
+        "rejected full step) differ from a full evaluation only in evaluate's arguments, which neither cProfile "
+        "nor the probe sees; their sum per iteration and the mean time of an evaluation over all kinds are in the "
+        "notes below.")
     lines += table_section(
         "Time per Newton iteration", SPLIT_HEADER, _split_rows(results),
         "Milliseconds per Newton iteration (category time / Newton iterations; the evaluations, factorisations and "
-        "eigen-solves outside the iterations proper are spread over them) and share of the wall time:")
+        "eigen-solves outside the iterations proper are spread over them) and share of the wall time, **measured "
+        "under cProfile** in a third, separate warm call of the same run and **scaled to the un-profiled wall time** "
+        f"(the profiled call took {_overhead(results)} times as long; cProfile's overhead is per Python call, so the "
+        "shares lean a little towards the Python-heavy categories). **assembly is n/a**: since issue 14 the "
+        "compiled kernels write straight into the band, there is no assembly step to time.")
     lines += [""] + [f"- {CATEGORY_LABELS[k]}" for k in ("evaluate", "kernels", "assembly", "evaluate_rest", "linalg",
-                                                  "eigen", "other")]
+                                                          "eigen", "other")]
     lines += [
         "",
-        "Method: the functions named above are wrapped with `time.perf_counter` timers at run time in the child "
-        "process (the library is not modified; the wrappers are removed afterwards). A call nested inside another "
-        "timed call is counted once, for the outermost one: the factorisations and Lanczos solves inside "
-        "`lowest_eigenpairs` are eigenvalue work, not (b); kernels and assembly are counted inside (a). Per-function "
-        "inclusive times by enclosing category are in the JSON (`calls.by_function`).",
+        "Method: cProfile's caller data of the profiled call (`benchmarks.common.CallGraph`); a category's time is "
+        "the time of its entry points' calls made outside any other category's call, so a call nested inside another "
+        "category's call counts once, for the outermost one: the factorisations and Lanczos solves inside "
+        "`lowest_eigenpairs` are eigenvalue work, not (b). Nothing in the library is patched. Per-function times by "
+        "enclosing category are in the JSON (`calls.by_function`, seconds under cProfile). Until issue 15 the "
+        "functions were wrapped with timers at run time; (a1) then read 0 (the compiled kernels were not found "
+        "as Python functions) and the evaluations were split by kind from evaluate's arguments.",
         "",
         f"- growth exponent d log(wall time) / d log(triangles) over {sc['triangles_fitted']}: " + slopes_markdown(sc),
         load_line(report),
     ]
     lines += section("Per run", report["observations"])
+    lines += ["", "Newton iterations per stage, per phase (`ddg.solve.continuation.PHASES`) and per recorded step come "
+              "from the probe of the warm call and add up to `summary['newton_iterations']` (checked: "
+              + ("yes" if all(r.get("probe_matches_summary") for r in results if r.get("status") == "ok") else "NO")
+              + "); until issue 15 they were counted per calling function (by caller). Threshold location and branch "
+              "tracing come from summary.json and are part of the wall time."]
     lines += machine_section(report)
     return "\n".join(lines)
+
+
+def build_report(results: list[dict], args, timeout) -> dict:
+    return {
+        "benchmark": "plate_path",
+        "scene": {"width_ratio": args.width_ratio, "compression_ratio": COMPRESSION_RATIO,
+                  "compression_steps": args.compression_steps, "shear_steps": args.shear_steps,
+                  "shear_ratio": "dW_max/L" if args.shear_ratio is None else args.shear_ratio, "model": "plate"},
+        "repeat": args.repeat,
+        "timeout_s": timeout,
+        "split_categories": CATEGORY_LABELS,
+        "method": "probe (ddg.solve.probe) on the warm call; split under cProfile in a separate warm call, outermost "
+                  "calls per category, scaled to the un-profiled wall time (see the module docstring)",
+        "results": results,
+    }
 
 
 def main(argv=None) -> int:
@@ -445,7 +370,7 @@ def main(argv=None) -> int:
     parser.add_argument("--repeat", type=int, default=1, help="runs per N; the best wall time is reported")
     parser.add_argument("--out", default="benchmarks/results", help="directory for plate_path.json and plate_path.md")
     parser.add_argument("--timeout", type=float, default=1800.0,
-                        help="seconds allowed for one run of one N (0: no limit); a run over it is stopped and reported")
+                        help="seconds allowed for one run of one N (0: no limit); a run over it is stopped, reported")
     args = parser.parse_args(argv)
     if args.repeat < 1 or any(t < 16 for t in args.triangles) or args.shear_steps < 1 or args.compression_steps < 1:
         parser.error("--repeat, --shear-steps, --compression-steps must be >= 1 and every N >= 16")
@@ -455,7 +380,7 @@ def main(argv=None) -> int:
 
     provenance = Provenance()
     results = [
-        best_of(functools.partial(run_in_child, _run_once, (n, config), timeout), args.repeat, f"N = {n}",
+        best_of(functools.partial(run_in_child, measure, (n, config), timeout), args.repeat, f"N = {n}",
                 {"triangles_target": n},
                 lambda p: (f"{p['triangles']} triangles, {p['wall_time_s']:.2f} s, {p['newton_iterations']} Newton "
                            f"its, complete {p['completed']}"),
@@ -463,17 +388,7 @@ def main(argv=None) -> int:
         for n in args.triangles
     ]
 
-    report = {
-        "benchmark": "plate_path",
-        "scene": {"width_ratio": args.width_ratio, "compression_ratio": COMPRESSION_RATIO,
-                  "compression_steps": args.compression_steps, "shear_steps": args.shear_steps,
-                  "shear_ratio": "dW_max/L" if args.shear_ratio is None else args.shear_ratio, "model": "plate"},
-        "repeat": args.repeat,
-        "timeout_s": timeout,
-        "split_categories": CATEGORY_LABELS,
-        "method": "run-time timer wrappers; nested timed calls counted once, by the outermost (see module docstring)",
-        "results": results,
-    }
+    report = build_report(results, args, timeout)
     wrote = finish_path_report(report, provenance, scaling, observations, markdown_report, args.out, blas=True)
 
     sc = report["scaling"]

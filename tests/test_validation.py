@@ -458,7 +458,7 @@ def test_claim_plate_matches_the_elastica():
 def test_claim_ribbon_matches_the_elastica():
     """Untwisted, the Sadowsky energy is the rod's bending energy: the compressed ribbon is the
     elastica (measured -2.6e-4 at M = 101)."""
-    from ddg.ribbon_runs import run_ribbon
+    from ddg.api import run_ribbon
 
     strip = ddg.Strip.from_ratios(1 / 20, 1 / 2)
     protocol = ddg.LoadingProtocol(1 / 2, shear_ratio=0.0, compression_steps=40, shear_steps=1)

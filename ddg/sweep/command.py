@@ -24,7 +24,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--model", nargs="+", default=["rod"], metavar="MODEL",
                         help="rod (default), plate, ribbon; several allowed")
     parser.add_argument("--width-ratios", nargs="+", default=[DEFAULT_WIDTHS], metavar="W/L",
-                        help="W/L values (default 1/20, 1/12, 1/6, 1/3, 1/2)")
+                        help="W/L values, comma- or space-separated as every list here (default 1/20, 1/12, 1/6, "
+                             "1/3, 1/2)")
     parser.add_argument("--compression-ratios", nargs="+", default=["0.5,0.25"], metavar="dL/L",
                         help="dL/L values (default 0.5, 0.25)")
     parser.add_argument("--slenderness", nargs="+", default=None, metavar="L/b",
@@ -98,7 +99,8 @@ def main(args) -> int:
     files = ", ".join(str(p) for p in written + figures)
     if not args.quiet:
         where = f" on {outcome.where}" if outcome.where else ""
-        print(f"sweep: {len(specs)} runs: {len(outcome.computed)} computed{where}, {len(outcome.cached)} cached, "
+        runs = f"{len(specs)} run{'s' * (len(specs) != 1)}"
+        print(f"sweep: {runs}: {len(outcome.computed)} computed{where}, {len(outcome.cached)} cached, "
               f"{len(outcome.errors)} failed, in {outcome.wall_time_s:.1f} s; wrote {files}")
     if outcome.interrupted is not None:
         done = len(outcome.results)

@@ -1,4 +1,4 @@
-"""python -m validation report [--quick | --full] [--out DIR] [--jobs N] [--quiet]"""
+"""python -m validation report [--quick | --full] [--out DIR] [--jobs N] [--scheduler ADDRESS] [--quiet]"""
 from __future__ import annotations
 
 import argparse
@@ -16,16 +16,21 @@ def main(argv=None) -> int:
     group.add_argument("--smoke", dest="profile", action="store_const", const="smoke", help=argparse.SUPPRESS)
     rep.add_argument("--out", default="out/validation", help="output directory (default out/validation)")
     rep.add_argument("--jobs", type=int, default=2, help="worker processes for the model runs (default 2)")
+    rep.add_argument("--scheduler", default=None,
+                     help="an existing Dask scheduler for the runs, e.g. tcp://host:8786 (default: a local cluster)")
     rep.add_argument("--quiet", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
     if args.jobs < 1:
         sys.stderr.write(f"error: --jobs = {args.jobs} must be >= 1\n")
         return 2
+    from ddg.geometry.strip import InputError
+
     from .report import MissingExtra, build_report
 
     try:
-        summary = build_report(args.profile or "quick", args.out, jobs=args.jobs, progress=not args.quiet)
-    except MissingExtra as exc:
+        summary = build_report(args.profile or "quick", args.out, jobs=args.jobs, progress=not args.quiet,
+                               scheduler=args.scheduler)
+    except (MissingExtra, InputError) as exc:
         sys.stderr.write(f"error: {exc}\n")
         return 2
     print(f"report: {args.out}/index.html ({summary['runs']} runs, {summary['report_wall_time_s']:.0f} s); "

@@ -165,15 +165,18 @@ def write_report(data: ReportData, out: Path) -> dict:
 
 
 def build_report(profile_name: str, out: Path, jobs: int = 1, progress: bool = True,
-                 gold_root: Path | None = None) -> dict:
-    """Run (or take from the cache) the profile's runs, then write the report in `out`; returns summary.json's dict.
-    Raises MissingExtra before any run if jinja2 or matplotlib is missing."""
+                 gold_root: Path | None = None, scheduler: str | None = None) -> dict:
+    """Run (or take from the cache) the profile's runs, then write the report in `out`; returns
+    summary.json's dict. scheduler: an existing Dask scheduler's address for the runs (default: a
+    LocalCluster of `jobs` workers, ddg.sweep). Raises MissingExtra before any run if jinja2 or
+    matplotlib is missing."""
     require_report_extras()
     t0 = time.perf_counter()
     profile = PROFILES[profile_name]()
     out = Path(out)
     study = specs(profile)
-    results = run_all([s for group in study.values() for s in group], out / "cache", jobs=jobs, progress=progress)
+    results = run_all([s for group in study.values() for s in group], out / "cache", jobs=jobs, progress=progress,
+                      scheduler=scheduler)
     data = collect(profile, study, results, gold_root)
     draw_figures(data.figures, out)
     data.timings.report_wall_time_s = time.perf_counter() - t0

@@ -59,6 +59,8 @@ TRIANGLES = [500, 1000, 2000, 4000]
 #: level 1: where the wall time goes; level 2: inside PlateModel.evaluate
 LEVEL1 = ("evaluate", "linalg", "eigen")
 LEVEL2 = ("kernels",)
+#: above this 1-minute load average (2 cores) the report says the machine was shared
+SHARED_LOAD = 1.5
 CATEGORY_LABELS = {
     "evaluate": "(a) element evaluation + assembly (PlateModel.evaluate)",
     "kernels": "(a1) energy/gradient/Hessian kernels: the compiled passes evaluate calls (ddg.energies add_edge_terms, "
@@ -283,6 +285,16 @@ def _overhead(results: list[dict]) -> str:
     return f"{min(ratios):.2f}-{max(ratios):.2f}" if ratios else NA
 
 
+def _shared_machine_note(report: dict) -> list[str]:
+    """A warning line when the load average says other processes shared the 2 cores."""
+    loads = [x for x in report["load_average"] if x is not None]
+    if not loads or max(loads) <= SHARED_LOAD:
+        return []
+    return [f"- the load average exceeded {SHARED_LOAD} (up to {max(loads):.1f} on {report['machine']['cpu_count']} "
+            "cores): other jobs shared the machine, so wall times are inflated; the CPU times and the iteration "
+            "counts are the figures to compare with other runs"]
+
+
 def markdown_report(report: dict) -> str:
     sc, scene = report["scaling"], report["scene"]
     results = report["results"]
@@ -333,6 +345,7 @@ def markdown_report(report: dict) -> str:
         "",
         f"- growth exponent d log(wall time) / d log(triangles) over {sc['triangles_fitted']}: " + slopes_markdown(sc),
         load_line(report),
+        *_shared_machine_note(report),
     ]
     lines += section("Per run", report["observations"])
     lines += ["", "Newton iterations per stage, per phase (`ddg.solve.continuation.PHASES`) and per recorded step come "

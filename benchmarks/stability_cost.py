@@ -27,7 +27,7 @@ import sys
 import time
 from pathlib import Path
 
-from benchmarks.common import PathProbe, function_key, profiled, run_in_child
+from benchmarks.common import PathProbe, function_key, profiled, ratio, run_in_child
 from ddg.output.io import atomic_write_text
 
 DEFAULT_CASES = ("rod:100", "plate:2000")
@@ -168,8 +168,8 @@ def markdown(records: list[dict]) -> str:
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.stability_cost", description=__doc__.splitlines()[0])
     parser.add_argument("--cases", nargs="+", default=list(DEFAULT_CASES), help="model:resolution, e.g. rod:100")
-    parser.add_argument("--width-ratio", type=float, nargs="+", default=[0.05, 1 / 6],
-                        help="W/L for the rod (first) and the plate (last)")
+    parser.add_argument("--width-ratio", type=ratio, nargs="+", default=[0.05, 1 / 6],
+                        help="W/L for the rod (first) and the plate (last); decimals or fractions")
     parser.add_argument("--branches", choices=("default", "on", "off"), default="default",
                         help="trace the branches (library default: rod yes, plate no)")
     parser.add_argument("--no-profile", action="store_true",

@@ -49,7 +49,8 @@ relative residual |A x - b| / |b| is recorded. Writes OUT/plate_linear_algebra.j
 the conclusion is computed from the tables. Timings of each (case, threads) child are also cached
 (keyed by this script's and ddg/solve/band_ldlt.py's sources and the timing options; --fresh retimes),
 so an interrupted run resumes; --report-only rewrites the report from the cached timings without measuring
-(whatever version of the code produced them: each record keeps its fingerprint). Not part of the test run. Smoke run (~1 min):
+(whatever version of the code produced them: each record keeps its fingerprint). Not part of the test
+run. Smoke run (~1 min):
 --cases 1/6:500 --repeat 3 --out /tmp/plate_la_smoke --cache /tmp/plate_la_smoke/cache.
 """
 from __future__ import annotations
@@ -347,7 +348,8 @@ def time_matrix(band: np.ndarray, repeat: int, budget: float, full: bool,
     A = band_to_csc(band, pattern)
     rhs = np.random.default_rng(0).standard_normal(n)
     rnorm = float(np.linalg.norm(rhs))
-    resid = lambda x: float(np.linalg.norm(A @ x - rhs) / rnorm)
+    def resid(x):
+        return float(np.linalg.norm(A @ x - rhs) / rnorm)
     t, inertia, notes = {}, {}, {}
     tol = n * np.finfo(float).eps * float(np.max(np.abs(band[0])))
 
@@ -752,7 +754,8 @@ def conclusion(records: list[dict]) -> list[str]:
         name, v, th = ranked[0]
         chol = next((x for x in ranked if x[0] == "banded Cholesky"), None)
         ldl = next((x for x in ranked if x[0].startswith("CHOLMOD LDL^T")), None)
-        text = (f"W/L = {s['label']}, {s['triangles']} triangles (n = {s['n']}, bandwidth {s['bandwidth']}), compressed "
+        text = (f"W/L = {s['label']}, {s['triangles']} triangles (n = {s['n']}, bandwidth {s['bandwidth']}), "
+                f"compressed "
                 f"(positive definite) Hessian, factor + one solve: fastest {name} at {v:.2f} ms ({th_label(th)})")
         if len(ranked) > 1:
             text += f", {ranked[1][1] / v:.2f}x faster than the next ({ranked[1][0]}, {ranked[1][1]:.2f} ms)"
@@ -761,7 +764,8 @@ def conclusion(records: list[dict]) -> list[str]:
                 text += (f"; banded Cholesky ({chol[1]:.2f} ms) is {ldl[1] / chol[1]:.2f}x faster than the fastest "
                          f"CHOLMOD LDL^T ({ldl[0].split()[-1]}, {ldl[1]:.2f} ms): use the banded Cholesky at this size")
             else:
-                text += (f"; the fastest CHOLMOD LDL^T ({ldl[0].split()[-1]}, {ldl[1]:.2f} ms) is {chol[1] / ldl[1]:.2f}x "
+                text += (f"; the fastest CHOLMOD LDL^T ({ldl[0].split()[-1]}, {ldl[1]:.2f} ms) is "
+                         f"{chol[1] / ldl[1]:.2f}x "
                          f"faster than banded Cholesky ({chol[1]:.2f} ms): use CHOLMOD LDL^T at this size")
         lines.append(text + ".")
     # 2. inertia on the indefinite matrices: the fastest way to the count of negative eigenvalues
@@ -802,8 +806,9 @@ def conclusion(records: list[dict]) -> list[str]:
                     p += f", CHOLMOD LDL^T {o} factor + solve {v:.2f} ms ({p0[0] / v:.2f}x)"
                 parts.append(p)
         if parts:
-            lines.append(f"Newton step on the indefinite Hessians at W/L = {r['width_label']}, {r['meta']['triangles']} "
-                         f"triangles (the project's path / the LDL^T, which also gives the inertia): " + "; ".join(parts) + ".")
+            lines.append(f"Newton step on the indefinite Hessians at W/L = {r['width_label']}, "
+                         f"{r['meta']['triangles']} triangles (the project's path / the LDL^T, which also gives "
+                         "the inertia): " + "; ".join(parts) + ".")
     # 3. inertia agreement
     rows = inertia_rows(records)
     dense_rows = [x for x in rows if x["dense"] and x["ldlt"]]
@@ -816,8 +821,10 @@ def conclusion(records: list[dict]) -> list[str]:
     unreliable = [x for x in all_counts if not x["ldlt"]["reliable"]]
     negs = sorted({x["ldlt"]["negative"] for x in all_counts if x["matrix"] != "compressed"})
     lines.append(
-        f"Inertia: the negative-pivot counts of the band LDL^T and of CHOLMOD's LDL^T ({', '.join(ORDERINGS)}) equal the "
-        f"dense eigenvalue count in {len(agree_dense)}/{len(dense_rows)} matrices with n <= the dense limit; band LDL^T "
+        f"Inertia: the negative-pivot counts of the band LDL^T and of CHOLMOD's LDL^T ({', '.join(ORDERINGS)}) equal "
+        f"the "
+        f"dense eigenvalue count in {len(agree_dense)}/{len(dense_rows)} matrices with n <= the dense limit; band "
+        f"LDL^T "
         f"and the three CHOLMOD orderings agree in {len(agree_all)}/{len(all_counts)} matrices; the banded Cholesky "
         f"succeeded exactly when the LDL^T had no negative or zero pivot in {len(pd_match)}/{len(all_counts)} "
         f"(negative counts of the indefinite matrices: {', '.join(map(str, negs)) or 'none'}); band LDL^T pivots "
@@ -847,8 +854,8 @@ def conclusion(records: list[dict]) -> list[str]:
         lines.append(
             f"BLAS threads, banded Cholesky factor on the compressed Hessian: default-threads time / 1-thread time = "
             f"{min(x[1] for x in thr):.2f} to {max(x[1] for x in thr):.2f}; one thread is faster in {len(faster)}/"
-            f"{len(thr)} cases" + (" (" + ", ".join(f"W/L = {x[0]['width_label']} at {x[0]['meta']['triangles']}" for x in faster) + ")"
-                                   if faster else "") + ".")
+            f"{len(thr)} cases" + (" (" + ", ".join(f"W/L = {x[0]['width_label']} at {x[0]['meta']['triangles']}"
+                                                    for x in faster) + ")" if faster else "") + ".")
     # 5. the band LDL^T kernel against banded Cholesky
     ratios = []
     for r in ok_records(records):
@@ -857,7 +864,8 @@ def conclusion(records: list[dict]) -> list[str]:
             if a and b:
                 ratios.append(a / b)
     if ratios:
-        lines.append(f"Band LDL^T kernel (ddg.solve.band_ldlt) / banded Cholesky factor time on the compressed Hessians: "
+        lines.append(f"Band LDL^T kernel (ddg.solve.band_ldlt) / banded Cholesky factor time on the compressed "
+                     f"Hessians: "
                      f"{min(ratios):.2f} to {max(ratios):.2f} (median {statistics.median(ratios):.2f}) over "
                      f"{len(ratios)} (case, threads) pairs.")
     # 6. element work against the factorisation
@@ -869,7 +877,8 @@ def conclusion(records: list[dict]) -> list[str]:
         if full and chol:
             ev.append(full / chol)
     if ev:
-        lines.append(f"Element evaluation + assembly (PlateModel.evaluate, full) costs {min(ev):.2f}x to {max(ev):.2f}x "
+        lines.append(f"Element evaluation + assembly (PlateModel.evaluate, full) costs {min(ev):.2f}x to "
+                     f"{max(ev):.2f}x "
                      f"the banded Cholesky factor (default threads); no more than it in {sum(x <= 1 for x in ev)}/"
                      f"{len(ev)} cases.")
     return lines
@@ -909,7 +918,8 @@ def main_rows(records) -> list[tuple]:
         th0 = next(iter(r["timings"]))
         cells = [_bt(best(r, "compressed", "banded Cholesky", "factor")),
                  _bt(best(r, "compressed", "banded Cholesky", "factor+solve")),
-                 _bt(best(r, "compressed", "band LDL^T", "factor")), _bt(best(r, "compressed", "band LDL^T", "factor+solve"))]
+                 _bt(best(r, "compressed", "band LDL^T", "factor")), _bt(best(r, "compressed", "band LDL^T",
+                                                                              "factor+solve"))]
         for o in ORDERINGS:
             cells += [_bt(best(r, "compressed", f"CHOLMOD LDL^T {o}", "factor")),
                       _bt(best(r, "compressed", f"CHOLMOD LDL^T {o}", "factor+solve"))]
@@ -954,16 +964,16 @@ def inertia_table_rows(records) -> list[tuple]:
     for r in ok_records(records):
         for mat in MATRICES:
             x = by[(r["width_label"], r["meta"]["triangles"], mat)]
-            d, l = x["dense"], x["ldlt"]
+            d, ld = x["dense"], x["ldlt"]
             cm = [str(c["negative"]) if c else "" for c in x["cholmod"].values()]
             times = [_bt(best(r, mat, "banded Cholesky", "factor")), _bt(best(r, mat, "band LDL^T", "factor"))]
             times += [_bt(best(r, mat, f"CHOLMOD LDL^T {o}", "factor")) for o in ORDERINGS]
             times.append(_bt(best(r, mat, "banded LU", "factor+solve")))
             rows.append((x["label"], str(x["triangles"]), mat, _f(r["meta"]["matrices"][mat]["dL_over_L"], ".3g"),
                          str(x["n"]), str(x["nnz"]), f"{d['negative']}/{d['zero']}/{d['positive']}" if d else "",
-                         f"{l['negative']}/{l['zero']}/{l['positive']}" if l else "",
-                         ("yes" if l["reliable"] else "NO") if l else "",
-                         _f(l["min_abs_pivot"] / l["tolerance"], ".2e") if l and l["tolerance"] else "",
+                         f"{ld['negative']}/{ld['zero']}/{ld['positive']}" if ld else "",
+                         ("yes" if ld["reliable"] else "NO") if ld else "",
+                         _f(ld["min_abs_pivot"] / ld["tolerance"], ".2e") if ld and ld["tolerance"] else "",
                          *cm, "yes" if x["chol"] else "no", *times))
     return rows
 
@@ -978,8 +988,10 @@ def other_rows(records) -> list[tuple]:
     for r in ok_records(records):
         th = "default" if "default" in r["timings"] else next(iter(r["timings"]))
         fac = r["timings"][th]["matrices"]["compressed"]["factorisations"]
-        g = lambda m, k="factor": _f(ms(r, th, "compressed", m, k))
-        nnz = lambda m: str(fac.get(m, {}).get("nnz_L", ""))
+        def g(m, k="factor"):
+            return _f(ms(r, th, "compressed", m, k))
+        def nnz(m):
+            return str(fac.get(m, {}).get("nnz_L", ""))
         mc = r["meta"]["matrices"]["compressed"]
         band_nnz = sum(mc["n"] - d for d in range(mc["bandwidth"] + 1))
         lu = fac.get("banded LU", {})
@@ -1000,12 +1012,14 @@ def element_rows(records) -> list[tuple]:
     for r in ok_records(records):
         d = r["timings"].get("default", {})
         el, eig = d.get("element", {}), d.get("eigen", {})
-        g = lambda dd, prefix: next((v["median_ms"] for k, v in dd.items() if k.startswith(prefix)), None)
+        def g(dd, prefix):
+            return next((v["median_ms"] for k, v in dd.items() if k.startswith(prefix)), None)
         full = g(el, "evaluate, full")
         chol = ms(r, "default", "compressed", "banded Cholesky", "factor")
         rows.append((r["width_label"], str(r["meta"]["triangles"]), _f(full), _f(g(el, "evaluate, energy +")),
                      _f(g(el, "evaluate, energy only")), _f(g(el, "band assembly")), _f(g(el, "restriction")),
-                     _f(eig.get("eigsh sigma=0", {}).get("median_ms")), _f(eig.get("lowest_eigenpairs", {}).get("median_ms")),
+                     _f(eig.get("eigsh sigma=0", {}).get("median_ms")), _f(eig.get("lowest_eigenpairs",
+                                                                                   {}).get("median_ms")),
                      _f(eig.get("lowest_eigenpairs, factor reused", {}).get("median_ms")),
                      _f(full / chol if full and chol else None)))
     return rows
@@ -1040,10 +1054,13 @@ def markdown_report(report: dict) -> str:
     lines += table_section(
         "Inertia and the indefinite Hessians (ms)", INERTIA_HEADER, inertia_table_rows(records),
         "dense = eigenvalues by `numpy.linalg.eigvalsh` (n <= the dense limit; zero = |lambda| <= n eps max|lambda|); "
-        "nnz = stored entries of the CSC matrix: the flat matrices are stored on the compressed matrix's pattern (at z = 0 "
-        "the in-plane and out-of-plane DOFs decouple and a third of the entries are exact zeros; a Newton Hessian keeps "
+        "nnz = stored entries of the CSC matrix: the flat matrices are stored on the compressed matrix's pattern (at z "
+        "= 0 "
+        "the in-plane and out-of-plane DOFs decouple and a third of the entries are exact zeros; a Newton Hessian "
+        "keeps "
         "its pattern, and the reused CHOLMOD analysis needs it); "
-        "band LDL^T = signs of the pivots of `ddg.solve.band_ldlt` (zero = |d| <= n eps max|A_jj|, then reliable = no); "
+        "band LDL^T = signs of the pivots of `ddg.solve.band_ldlt` (zero = |d| <= n eps max|A_jj|, then reliable = "
+        "no); "
         "min|d| / tol = the smallest pivot magnitude over that tolerance; CHOLMOD neg = negative entries of "
         "`Factor.D()` of the simplicial LDL^T per ordering; chol succeeds = the banded Cholesky factors the matrix "
         "(positive definite). Times: chol = to success or to LAPACK's failure; band LDL^T and CHOLMOD LDL^T factor "
@@ -1051,21 +1068,24 @@ def markdown_report(report: dict) -> str:
     lines += table_section(
         "BLAS threads: default against one (ms, compressed Hessian)", THREAD_HEADER, thread_rows(records),
         "Each pair: the same measurement in the child with the inherited environment (default) and in one started "
-        "with OPENBLAS_NUM_THREADS=OMP_NUM_THREADS=1. BLAS threads = `openblas_get_num_threads()` in the default child.")
+        "with OPENBLAS_NUM_THREADS=OMP_NUM_THREADS=1. BLAS threads = `openblas_get_num_threads()` in the default "
+        "child.")
     lines += table_section(
         "Other factorisations, analysis and fill (ms, default threads, compressed Hessian)", OTHER_HEADER,
         other_rows(records),
         "LU f+s = `scipy.linalg.solve_banded` (LAPACK gbsv) and the conversion to its storage; SuperLU = `splu` factor "
         "(COLAMD default; MMD = permc_spec='MMD_AT_PLUS_A'; MMD sym = the same with diag_pivot_thresh=0 and "
         f"SymmetricMode; natural = the band order; MMD not run above n = {SUPERLU_MMD_MAX_N}); CHOLMOD analysis = "
-        "`analyze` alone; incl. analysis = `cholmod.cholesky(A, mode='simplicial', ordering_method=o)`; nnz(L): the band "
+        "`analyze` alone; incl. analysis = `cholmod.cholesky(A, mode='simplicial', ordering_method=o)`; nnz(L): the "
+        "band "
         "factor's stored entries, `Factor.LD()` (LDL^T, with D) and `Factor.L()` (supernodal).")
     lines += table_section(
         "Element work and eigen-solve (ms, default threads, compressed state)", ELEMENT_HEADER, element_rows(records),
         "evaluate full = `PlateModel.evaluate(q)`; energy+grad = `evaluate(q, hessian=False)`; energy only = "
         "`evaluate(q, gradient=False, hessian=False)`; assembly = `BandAssembler.assemble` alone (empty when evaluate "
         "does not call it); restrict = `SymmetricBanded.restrict` to the free DOFs; eigsh sigma=0 = "
-        "`scipy.sparse.linalg.eigsh(A, k=1, sigma=0, tol=1e-12)`; lowest_eigenpairs = `SymmetricBanded.lowest_eigenpairs(1)`"
+        "`scipy.sparse.linalg.eigsh(A, k=1, sigma=0, tol=1e-12)`; lowest_eigenpairs = "
+        "`SymmetricBanded.lowest_eigenpairs(1)`"
         " fresh and with its Cholesky already computed; eval/chol = evaluate full over the banded Cholesky factor.")
     lines += section("Notes")
     for r in records:
@@ -1074,7 +1094,8 @@ def markdown_report(report: dict) -> str:
             continue
         m = r["meta"]
         st = m["state"]
-        flat = "; ".join(f"{k}: dL/L = {v['dL_over_L']:.3g}, in-plane Newton |g| {v['newton_gradient_norms'][0]:.2e} -> "
+        flat = "; ".join(f"{k}: dL/L = {v['dL_over_L']:.3g}, in-plane Newton |g| {v['newton_gradient_norms'][0]:.2e} "
+                         f"-> "
                          f"{v['newton_gradient_norms'][-1]:.2e}, max|z| {v['max_abs_z']:.1e}"
                          for k, v in m["matrices"].items() if "newton_gradient_norms" in v)
         notes = []
@@ -1106,7 +1127,8 @@ def markdown_report(report: dict) -> str:
 
 
 CHOLMOD_INSTALL = (
-    "`.venv/bin/python -m pip install -c .venv/constraints.txt scikit-sparse` (with build isolation) built and installed "
+    "`.venv/bin/python -m pip install -c .venv/constraints.txt scikit-sparse` (with build isolation) built and "
+    "installed "
     "scikit-sparse 0.4.16 from its sdist against the system SuiteSparse 5.12 (libsuitesparse-dev: libcholmod.so.3, "
     "linked to METIS 5 and OpenBLAS); pip first tried 0.5.0, whose metadata requires numpy > 2.0 and scipy >= 1.14, "
     "which the constraints (numpy 1.24.2, scipy 1.10.1) exclude. No --no-build-isolation or Cython install was needed.")

@@ -24,6 +24,7 @@ import json
 import math
 import os
 import subprocess
+import tempfile
 import sys
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
@@ -450,14 +451,52 @@ def _clim(frames, color_by: str):
     return (lo, hi) if hi > lo else (lo - 0.5, hi + 0.5)
 
 
+#: Modules after whose import an in-process EGL render aborts the interpreter.
+_UNSAFE_FOR_EGL = ("dolfinx", "petsc4py")
+
+
+def _draw_in_child(panels, timeout: float = 300.0, **options) -> np.ndarray:
+    """draw() in a fresh interpreter: the panels and options pickled to it, the image back."""
+    import pickle
+
+    package_root = str(Path(__file__).resolve().parents[2])
+    env = dict(os.environ)
+    env["PYTHONPATH"] = package_root + (os.pathsep + env["PYTHONPATH"] if env.get("PYTHONPATH") else "")
+    with tempfile.TemporaryDirectory(prefix="ddg-render-") as tmp:
+        job, image = Path(tmp) / "job.pickle", Path(tmp) / "image.npy"
+        job.write_bytes(pickle.dumps((panels, options, str(image))))
+        child = "import sys; from ddg.output.render import _draw_child; _draw_child(sys.argv[1])"
+        proc = subprocess.run([sys.executable, "-c", child, str(job)], capture_output=True, text=True, env=env,
+                              timeout=timeout)
+        if proc.returncode != 0 or not image.exists():
+            lines = [ln for ln in proc.stderr.splitlines() if ln.strip() and "WARN|" not in ln]
+            raise RuntimeError(f"rendering failed: {lines[-1] if lines else f'exit code {proc.returncode}'}")
+        return np.load(image)
+
+
+def _draw_child(job_path: str) -> None:
+    """Child side of _draw_in_child."""
+    import pickle
+
+    panels, options, image = pickle.loads(Path(job_path).read_bytes())
+    np.save(image, draw(panels, **options))
+
+
 def draw(frames_and_titles, *, columns: int | None = None, window_size=None, color_by: str = "z",
          fit_to=None, clim=None, show_edges: bool = False) -> np.ndarray:
     """RGB image (H, W, 3) of one or more states in a grid of `columns` panels, each with its title,
     all seen by the same fixed camera fitted to all of them (or to `fit_to`: (K, 3) points or (6,)
     bounds, units of L), colours on one scale (`clim`, default the range over all panels). A panel
-    whose frame is None stays empty (keeps the grid's rows aligned)."""
-    pv = import_pyvista()
+    whose frame is None stays empty (keeps the grid's rows aligned).
+
+    In a process that has loaded dolfinx/PETSc (the FEM reference, or a test session that ran
+    it), vtk's off-screen EGL context aborts the interpreter (measured: SIGABRT in
+    vtkRenderWindow::Render); there the drawing is done in a child interpreter."""
     panels = list(frames_and_titles)
+    if any(name in sys.modules for name in _UNSAFE_FOR_EGL):
+        return _draw_in_child(panels, columns=columns, window_size=window_size, color_by=color_by, fit_to=fit_to,
+                              clim=clim, show_edges=show_edges)
+    pv = import_pyvista()
     count = len(panels)
     columns = count if columns is None else max(1, min(int(columns), count))
     rows = math.ceil(count / columns)

@@ -311,7 +311,10 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
                         stage = "the branch switch (U to US)"
                         tt = time.perf_counter()
                         with clock.section("branch switching"):
-                            values, vectors = solver.lowest_modes(1)
+                            if obs.mode is not None:  # the critical mode of this state, observed above
+                                values, vectors = [obs.row["lambda_min"]], [obs.mode]
+                            else:
+                                values, vectors = solver.lowest_modes(1)
                             it_sw, amp = switch_branch(stepper, vectors[0], options.perturbation)
                         rows.pop()
                         centerlines.pop()

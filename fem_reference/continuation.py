@@ -248,12 +248,11 @@ class Observer:
         pos = m.positions()
         phase, mirror, point = phase_of(m, pos)
         force = m.clamp_reaction() / 12.0  # units of E b^3 / L (D = 1, see shell docstring)
-        negative = self.solver.negative_eigenvalues()
+        # inertia and lambda_min from one assembly and one factorisation of the tangent
+        negative, values, vectors = self.solver.stability(1 if self.eigenvalues or want_mode else 0)
         lam, mode = float("nan"), None
-        if self.eigenvalues or want_mode:
-            values, vectors = self.solver.lowest_modes(1)
-            if len(values):
-                lam, mode = float(values[0]), vectors[0]
+        if len(values):
+            lam, mode = float(values[0]), vectors[0]
         compression, shear = m.clamp
         row = {
             "stage": stage,

@@ -130,6 +130,24 @@ class NewtonOptions:
     stall_window: int = 0
 
 
+def _without_zeros(M: PETSc.Mat) -> PETSc.Mat:
+    """The assembled matrix M with its stored zeros dropped: the metric M has values only in the
+    displacement block (129093 of the mixed pattern's 930825 entries at 60 x 10 elements), so a
+    product with it costs 0.15 ms instead of 1.1 ms; SLEPc's shift-invert makes ~20 per
+    eigensolve."""
+    import scipy.sparse
+
+    M.assemble()
+    indptr, indices, values = M.getValuesCSR()
+    csr = scipy.sparse.csr_matrix((values, indices, indptr), shape=M.getSize())
+    csr.eliminate_zeros()
+    out = PETSc.Mat().createAIJ(size=M.getSizes(), comm=M.getComm(),
+                                csr=(csr.indptr.astype(PETSc.IntType), csr.indices.astype(PETSc.IntType), csr.data))
+    out.assemble()
+    M.destroy()
+    return out
+
+
 def _cholesky_ksp(comm, prefix: str, inertia: bool = False) -> PETSc.KSP:
     ksp = PETSc.KSP().create(comm)
     ksp.setOptionsPrefix(prefix)
@@ -159,8 +177,7 @@ class Solver:
         self.dx = self.b.duplicate()
         self.ksp = _cholesky_ksp(comm, "fem_newton_")
         self.inertia_ksp = _cholesky_ksp(comm, "fem_inertia_", inertia=True)
-        self.M = fem.petsc.assemble_matrix(model.mass_form, bcs=model.bcs, diagonal=0.0)
-        self.M.assemble()
+        self.M = _without_zeros(fem.petsc.assemble_matrix(model.mass_form, bcs=model.bcs, diagonal=0.0))
         self.total_iterations = 0
         #: Newton iterations per phase (ITERATION_PHASES); they sum to total_iterations
         self.iterations_by_phase: dict[str, int] = dict.fromkeys(ITERATION_PHASES, 0)
@@ -413,6 +430,26 @@ class Solver:
             nneg, nzero, _npos = factor.getInertia()
         return int(nneg + nzero)
 
+    def stability(self, modes: int = 1):
+        """(negative, eigenvalues, vectors) at the current q from one tangent assembly and one
+        MUMPS factorisation: the number of negative eigenvalues of the constrained tangent from
+        the inertia of its L D L^T (as negative_eigenvalues), then the `modes` eigenpairs of
+        K v = lambda M v nearest 0 (as lowest_modes) by SLEPc's shift-invert at 0 on that same
+        factorisation (ST in place: K - 0 M is K itself) instead of a copy factorised again.
+        modes = 0: the inertia only."""
+        A = self.assemble_tangent()
+        with self.clock.section("eigenvalues and inertia"):
+            self.inertia_ksp.setOperators(A)
+            self.inertia_ksp.setUp()
+            nneg, nzero, _npos = self.inertia_ksp.getPC().getFactorMatrix().getInertia()
+            if modes <= 0:
+                return int(nneg + nzero), np.array([]), []
+            from slepc4py import SLEPc
+
+            values, vectors = self._lowest_modes(A, modes, 0.0, SLEPc, factored=self.inertia_ksp,
+                                                 ncv=max(2 * modes + 4, 6))
+        return int(nneg + nzero), values, vectors
+
     def lowest_modes(self, count: int = 1, target: float = 0.0):
         """The `count` eigenpairs of K v = lambda M v nearest `target` (shift-invert, SLEPc),
         sorted by eigenvalue; lambda is already lambda_min L^4 / EI2 (shell.eigen_normalisation).
@@ -423,22 +460,32 @@ class Solver:
         with self.clock.section("eigenvalues and inertia"):
             return self._lowest_modes(A, count, target, SLEPc)
 
-    def _lowest_modes(self, A, count, target, SLEPc):
-        K = A.copy()
+    def _lowest_modes(self, A, count, target, SLEPc, factored: PETSc.KSP | None = None, ncv: int | None = None):
+        """SLEPc shift-invert about target; `factored`: a KSP already holding the factorisation
+        of A (target 0 only), used in place (SLEPc resets it afterwards); ncv: the Krylov
+        subspace (default max(2 count + 8, 12); stability() takes 6 for one mode: the same
+        eigenvalue to 1e-15 relative in half the solves, measured at 60 x 10 elements)."""
+        K = A if factored is not None else A.copy()
         eps = SLEPc.EPS().create(self.model.mesh.comm)
         eps.setOperators(K, self.M)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(count, max(2 * count + 8, 12))
+        eps.setDimensions(count, ncv or max(2 * count + 8, 12))
         eps.setTarget(target)
         eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
         st = eps.getST()
         st.setType(SLEPc.ST.Type.SINVERT)
         st.setShift(target)
-        ksp = st.getKSP()
-        ksp.setType("preonly")
-        pc = ksp.getPC()
-        pc.setType("cholesky")
-        pc.setFactorSolverType("mumps")
+        if factored is not None:
+            if target != 0.0:
+                raise ValueError("a factorisation of K is reused for the shift 0 only")
+            st.setMatMode(SLEPc.ST.MatMode.INPLACE)
+            st.setKSP(factored)
+        else:
+            ksp = st.getKSP()
+            ksp.setType("preonly")
+            pc = ksp.getPC()
+            pc.setType("cholesky")
+            pc.setFactorSolverType("mumps")
         eps.setTolerances(1e-10, 200)
         eps.solve()
         nconv = eps.getConverged()
@@ -449,6 +496,7 @@ class Solver:
             values.append(lam.real)
             vectors.append(vr.getArray().copy())
         eps.destroy()
-        K.destroy()
+        if factored is None:
+            K.destroy()
         order = np.argsort(values)
         return np.array(values)[order][:count], [vectors[i] for i in order[:count]]

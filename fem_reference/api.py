@@ -4,7 +4,7 @@ path.csv has ddg.analysis.observables.PATH_COLUMNS, then EXTRA_COLUMNS, then the
 (FEM_COLUMNS); summary.json every key of ddg.api.base_summary plus recorded_steps,
 resolved_up_to_dW_over_L, the FEM's timing keys and its iteration and time breakdowns
 (newton_iterations_by_phase: fem_reference.solver.ITERATION_PHASES, summing to newton_iterations,
-then counts of failed solves, step halvings and snaps; wall_time_by_phase_s:
+then counts of failed solves, step halvings, snaps and chord steps; wall_time_by_phase_s:
 fem_reference.solver.TIME_PHASES, summing to wall_time_s; wall_time_within_phases_s: the split of
 threshold location and branch switching into the same sections). XDMF fields (P1 interpolations of the
 displacement and rotations per recorded step) go to DIR/fields.xdmf for ParaView.

@@ -110,9 +110,10 @@ class Stepper:
         """summary.json's newton_iterations_by_phase: the solver's Newton iterations per phase
         (ITERATION_PHASES; they sum to solver.total_iterations), then counts (not iterations):
         "failed solves" (Newton solves that raised NewtonFailure, every phase), "step halvings"
-        and "snaps" (Stepper.advance, every phase)."""
+        and "snaps" (Stepper.advance, every phase), "chord steps" (iterations that reused the
+        last factorisation, NewtonOptions.chord_below; already counted in the phases)."""
         return {**self.solver.iterations_by_phase, "failed solves": self.solver.failed_solves,
-                "step halvings": self.step_halvings, "snaps": self.snaps}
+                "step halvings": self.step_halvings, "snaps": self.snaps, "chord steps": self.solver.chord_steps}
 
     @property
     def load(self) -> np.ndarray:

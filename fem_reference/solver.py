@@ -117,6 +117,14 @@ class NewtonOptions:
     a round-off floor of 1e-8 to 1e-7 (membrane stiffness / bending stiffness ~ (L/b)^2,
     measured), hence the correction criterion.
 
+    chord_below > 0: after a full Newton iteration whose correction was below chord_below (units of
+    L), the next correction reuses that iteration's factorisation (a chord step: one residual
+    assembly and two triangular solves instead of a tangent assembly and a factorisation). In
+    the quadratic regime that correction is the one that confirms convergence (below dx_tol);
+    the convergence test is unchanged (a correction below dx_tol), and a chord correction that
+    is not below it is kept and followed by full Newton iterations. Chord steps count as
+    iterations (Solver.chord_steps says how many there were).
+
     stall_window > 0: give up (NewtonFailure) when the smallest residual so far has not halved in
     the last stall_window iterations. Off (0) on the path; the dW2 bisection uses it: past the
     fold of US Newton from the US side oscillates between two residual levels until
@@ -128,6 +136,7 @@ class NewtonOptions:
     max_iterations: int = 25
     divergence_factor: float = 1e4
     stall_window: int = 0
+    chord_below: float = 1e-5
 
 
 def _without_zeros(M: PETSc.Mat) -> PETSc.Mat:
@@ -185,6 +194,8 @@ class Solver:
         self.failed_solves = 0
         #: iterations of the last solve, converged or not
         self.last_iterations = 0
+        #: Newton iterations made as chord steps (NewtonOptions.chord_below; counted in the phases)
+        self.chord_steps = 0
         #: wall time per section (assembly, factorisation, linear solves, eigenvalues and inertia,
         #: and those the continuation opens)
         self.clock = PhaseClock()
@@ -253,6 +264,7 @@ class Solver:
         x = m.q.vector
         r0 = None
         best: list[float] = []  # smallest residual up to each iteration
+        chord = False  # this iteration reuses the last factorisation
         for it in range(opts.max_iterations + 1):
             b = self.assemble_residual()
             r = b.norm()
@@ -273,10 +285,15 @@ class Solver:
                 raise self._fail(it, f"residual stalled at {best[-1]:.3e} for {window} iterations")
             if it == opts.max_iterations:
                 break
-            self.assemble_tangent()
-            self.ksp.setOperators(self.A)
             try:
-                self._factor_and_solve(self.ksp, b, self.dx)
+                if chord:  # the factorisation of the last iteration (self.A is unchanged since)
+                    self.chord_steps += 1
+                    with self.clock.section("linear solves"):
+                        self.ksp.solve(b, self.dx)
+                else:
+                    self.assemble_tangent()
+                    self.ksp.setOperators(self.A)
+                    self._factor_and_solve(self.ksp, b, self.dx)
             except PETSc.Error as exc:  # factorisation failure
                 raise self._fail(it, f"factorisation failed: {exc}") from None
             if self.ksp.getConvergedReason() < 0:
@@ -289,6 +306,7 @@ class Solver:
             if step < opts.dx_tol:
                 self._spent(it + 1, True)
                 return it + 1
+            chord = not chord and step < opts.chord_below
         raise self._fail(opts.max_iterations,
                          f"no convergence in {opts.max_iterations} iterations (|R| = {r:.3e}, |R0| = {r0:.3e})")
 

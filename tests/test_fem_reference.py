@@ -100,7 +100,7 @@ def test_summary_breaks_down_iterations_and_wall_time_by_phase(tmp_path):
     """summary.json's newton_iterations_by_phase: one entry per ITERATION_PHASES summing to
     newton_iterations (compression start, accepted steps, the dW1 bisection and the branch
     switch all used on a 12 x 10 mesh sheared past the pitchfork), then the counts of failed
-    solves, step halvings and snaps; threshold_newton_iterations = the dW1 and dW2 phases;
+    solves, step halvings, snaps and chord steps; threshold_newton_iterations = the dW1 and dW2 phases;
     wall_time_by_phase_s: every TIME_PHASES entry, non-negative except the remainder "other",
     summing to wall_time_s."""
     from fem_reference.api import simulate
@@ -112,7 +112,7 @@ def test_summary_breaks_down_iterations_and_wall_time_by_phase(tmp_path):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["converged"], summary["message"]
     by_phase = summary["newton_iterations_by_phase"]
-    assert set(ITERATION_PHASES) | {"failed solves", "step halvings", "snaps"} == set(by_phase)
+    assert set(ITERATION_PHASES) | {"failed solves", "step halvings", "snaps", "chord steps"} == set(by_phase)
     assert sum(by_phase[p] for p in ITERATION_PHASES) == summary["newton_iterations"]
     for phase in ("compression start", "accepted steps", "threshold dW1", "branch switching"):
         assert by_phase[phase] > 0, (phase, by_phase)

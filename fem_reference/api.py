@@ -244,6 +244,7 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
     t0_path = time.perf_counter()
     switched = False
     last_stable_u = None  # (load, state, history) of the last recorded stable U state
+    last_stable_u_lambda = float("nan")  # its lambda_min
     last_us = None
     dw1_info = dw2_info = None
     step_times = []
@@ -297,6 +298,7 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
                 if obs.negative == 0:
                     last_stable_u = (stepper.load, model.get_state(),
                                      Branch(list(stepper.branch.loads), list(stepper.branch.states)))
+                    last_stable_u_lambda = row["lambda_min"]
                 elif options.thresholds or options.branch_switching:
                     here = (stepper.load, model.get_state(),
                             Branch(list(stepper.branch.loads), list(stepper.branch.states)))
@@ -304,7 +306,8 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
                         stage = "threshold location (dW1, bisection on U)"
                         tt = time.perf_counter()
                         with clock.section("threshold location"):
-                            dw1, it1 = locate_dw1(stepper, last_stable_u, target[1])
+                            dw1, it1 = locate_dw1(stepper, last_stable_u, target[1],
+                                                  lambdas=(last_stable_u_lambda, row["lambda_min"]))
                             stepper.restore(here[0], here[1], here[2])
                         dw1_info = {"dW1": dw1, "iterations": it1, "time": time.perf_counter() - tt}
                     if options.branch_switching:

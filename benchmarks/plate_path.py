@@ -281,8 +281,16 @@ def observations(results: list[dict]) -> list[str]:
 
 
 def _overhead(results: list[dict]) -> str:
+    """The profiled call's wall time against the un-profiled one's, and what it means for the split."""
     ratios = [r["profiled_wall_time_s"] / r["wall_time_s"] for r in results if r.get("status") == "ok"]
-    return f"{min(ratios):.2f}-{max(ratios):.2f}" if ratios else NA
+    if not ratios:
+        return "no run to compare"
+    text = f"the profiled call took {min(ratios):.2f}-{max(ratios):.2f} times as long as the un-profiled one; "
+    if max(abs(x - 1.0) for x in ratios) <= 0.15:
+        return text + ("within 15 %: cProfile's per-call overhead is small against the compiled and LAPACK work, and "
+                       "the two calls differ as much by the machine's load and BLAS threads as by it")
+    return text + ("cProfile's overhead is per Python call, so the shares lean a little towards the Python-heavy "
+                   "categories")
 
 
 def _shared_machine_note(report: dict) -> list[str]:
@@ -328,8 +336,7 @@ def markdown_report(report: dict) -> str:
         "Milliseconds per Newton iteration (category time / Newton iterations; the evaluations, factorisations and "
         "eigen-solves outside the iterations proper are spread over them) and share of the wall time, **measured "
         "under cProfile** in a third, separate warm call of the same run and **scaled to the un-profiled wall time** "
-        f"(the profiled call took {_overhead(results)} times as long; cProfile's overhead is per Python call, so the "
-        "shares lean a little towards the Python-heavy categories). **assembly is n/a**: since issue 14 the "
+        f"({_overhead(results)}). **assembly is n/a**: since issue 14 the "
         "compiled kernels write straight into the band, there is no assembly step to time.")
     lines += [""] + [f"- {CATEGORY_LABELS[k]}" for k in ("evaluate", "kernels", "assembly", "evaluate_rest", "linalg",
                                                           "eigen", "other")]

@@ -14,17 +14,21 @@ branch switching (paper section 4, App. B, E).
   A substep that still fails below 1e-4 L is past a fold: the state snaps to the next stable
   equilibrium by Levenberg-Marquardt energy descent (solver.Solver.descend).
 * Stability after every recorded step: inertia of the constrained tangent (MUMPS L D L^T) and
-  its lowest eigenvalue in the metric of shell.EIGEN_NORMALISATION (SLEPc shift-invert).
+  its lowest eigenvalue in the metric of shell.EIGEN_NORMALISATION (SLEPc shift-invert on the
+  same factorisation, solver.Solver.stability).
 * dW1: the symmetric mesh keeps the U branch exactly symmetric, so the path stays on U past the
   pitchfork; at the first recorded step with a negative eigenvalue the bracket is bisected on
-  the U branch (solving from the last stable U state) until it is narrower than 1e-4 L.
+  the U branch (solving from the last stable U state, the inertia deciding) until it is
+  narrower than 1e-4 L, the first two points straddling the secant root of the recorded
+  lambda_min (locate_dw1).
 * Branch switch: at that step, the critical mode phi (displacement part normalised to max 1 in
   units of L, sign chosen so the highest point moves into the first half: US+) is added with
   the amplitude that minimises the energy along phi, searched from `perturbation` upward
   (or downward) by factors of 2, then Newton. The switch counts only if the result is US
   (no half-turn symmetry to 1e-4 L) and has no negative eigenvalue.
 * dW2: once on US, the first recorded step labelled S is bracketed and bisected (solving from
-  the last US state) to 1e-3 L: dW2 is the smallest dW found in S.
+  the last US state) to 1e-3 L: dW2 is the smallest dW found in S (a failed advance past the
+  fold of US narrows the bracket to the substep that failed, locate_dw2).
 
 Counters: every Newton solve counts its iterations in one phase of solver.ITERATION_PHASES
 (Stepper.advance: "accepted steps" / "rejected steps" / "fold snaps", or the threshold phase the

@@ -160,6 +160,8 @@ def load_before(path) -> dict | None:
     before = data.get("before") or data.get("result")
     if not before or before.get("status") != "ok":
         raise SystemExit(f"{path}: no successful run to compare with")
+    before = dict(before)
+    before.setdefault("load_average", data.get("load_average"))  # of the run that measured it
     return before
 
 
@@ -353,7 +355,9 @@ def markdown_report(report: dict) -> str:
         "",
         "iterations per recorded step = newton_iterations / recorded steps (161: the flat state, 40 compression, "
         "120 shear); without threshold location = the same without the dW1 and dW2 bisections. CPU time is the "
-        "benchmark process's (wall time above it: the process waited for a core).",
+        "benchmark process's, MUMPS's second thread included (busy-waiting too): it rises when the second core "
+        "is free and falls when another process holds it, so compare wall times (at similar load) and "
+        "iterations; wall time above CPU time means the process waited for a core.",
     ]
     lines += section("Newton iterations by phase") + [
         markdown_table(("phase", "before", "now", "now %"), phase_rows(before, now)), "",
@@ -388,6 +392,9 @@ def markdown_report(report: dict) -> str:
     if report.get("notes"):
         lines += section("Changes measured here", report["notes"])
     lines += [""] + [load_line(report)]
+    if before and before.get("load_average"):
+        lines.append(f"- load average (1 min) before / after the before run: {before['load_average'][0]} / "
+                     f"{before['load_average'][1]}")
     fem_sha = now["fem_reference_source_sha256"][:16]
     lines += machine_section(report, extra=f" fem_reference sources sha256 `{fem_sha}`;")
     return "\n".join(lines)

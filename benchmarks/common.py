@@ -677,3 +677,16 @@ def finish_path_report(report: dict, provenance: Provenance, scaling, observatio
     wrote = write_report(out, report["benchmark"], report, markdown_report(report))
     warn_if_changed(report)
     return wrote
+
+
+#: Load average above which other processes are taken to have shared the 2 cores.
+SHARED_LOAD = 1.5
+
+def shared_machine_note(report: dict) -> list[str]:
+    """A warning line when the load average says other processes shared the 2 cores."""
+    loads = [x for x in report["load_average"] if x is not None]
+    if not loads or max(loads) <= SHARED_LOAD:
+        return []
+    return [f"- the load average exceeded {SHARED_LOAD} (up to {max(loads):.1f} on {report['machine']['cpu_count']} "
+            "cores): other jobs shared the machine, so wall times are inflated; the CPU times and the iteration "
+            "counts are the figures to compare with other runs"]

@@ -46,6 +46,7 @@ import functools
 import sys
 
 from benchmarks.common import (Provenance, after_path_text, best_of, category_split, eigen_calls, eigen_paths_text,
+                               shared_machine_note,
                                finish_path_report, fit_slope, fmt, function_key, load_line, machine_section,
                                measure_path, newton_notes, path_slopes, path_timing, ratio, run_in_child, run_notes,
                                section, slopes_markdown, slopes_text, source_fingerprint, table_section, text_table)
@@ -59,8 +60,6 @@ TRIANGLES = [500, 1000, 2000, 4000]
 #: level 1: where the wall time goes; level 2: inside PlateModel.evaluate
 LEVEL1 = ("evaluate", "linalg", "eigen")
 LEVEL2 = ("kernels",)
-#: above this 1-minute load average (2 cores) the report says the machine was shared
-SHARED_LOAD = 1.5
 CATEGORY_LABELS = {
     "evaluate": "(a) element evaluation + assembly (PlateModel.evaluate)",
     "kernels": "(a1) energy/gradient/Hessian kernels: the compiled passes evaluate calls (ddg.energies add_edge_terms, "
@@ -293,15 +292,6 @@ def _overhead(results: list[dict]) -> str:
                    "categories")
 
 
-def _shared_machine_note(report: dict) -> list[str]:
-    """A warning line when the load average says other processes shared the 2 cores."""
-    loads = [x for x in report["load_average"] if x is not None]
-    if not loads or max(loads) <= SHARED_LOAD:
-        return []
-    return [f"- the load average exceeded {SHARED_LOAD} (up to {max(loads):.1f} on {report['machine']['cpu_count']} "
-            "cores): other jobs shared the machine, so wall times are inflated; the CPU times and the iteration "
-            "counts are the figures to compare with other runs"]
-
 
 def markdown_report(report: dict) -> str:
     sc, scene = report["scaling"], report["scene"]
@@ -352,7 +342,7 @@ def markdown_report(report: dict) -> str:
         "",
         f"- growth exponent d log(wall time) / d log(triangles) over {sc['triangles_fitted']}: " + slopes_markdown(sc),
         load_line(report),
-        *_shared_machine_note(report),
+        *shared_machine_note(report),
     ]
     lines += section("Per run", report["observations"])
     lines += ["", "Newton iterations per stage, per phase (`ddg.solve.continuation.PHASES`) and per recorded step come "

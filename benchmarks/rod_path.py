@@ -38,6 +38,7 @@ import math
 import sys
 
 from benchmarks.common import (Provenance, after_path_text, best_of, category_split, eigen_calls, eigen_paths_text,
+                               shared_machine_note,
                                finish_path_report, fit_slope, fmt, load_line, machine_section, markdown_table,
                                measure_path, newton_notes, path_slopes, path_timing, run_in_child, run_notes, section,
                                slopes_markdown, slopes_text, source_fingerprint, text_table)
@@ -47,8 +48,6 @@ COMPRESSION_RATIO = 0.5
 COMPRESSION_STEPS = 40
 SHEAR_STEPS = 120
 CATEGORIES = ("evaluate", "linalg", "eigen")
-#: above this 1-minute load average (2 cores) the report says the machine was shared
-SHARED_LOAD = 1.5
 CATEGORY_LABELS = {
     "evaluate": "energy/gradient/Hessian (RodModel.evaluate)",
     "linalg": "linear algebra (SymmetricBanded.cholesky, .solve, .ldlt)",
@@ -224,15 +223,6 @@ def _previous_split(results: list[dict]) -> str:
                      for r in results if r.get("status") == "ok")
 
 
-def _shared_machine_note(report: dict) -> list[str]:
-    """A warning line when the load average says other processes shared the 2 cores."""
-    loads = [x for x in report["load_average"] if x is not None]
-    if not loads or max(loads) <= SHARED_LOAD:
-        return []
-    return [f"- the load average exceeded {SHARED_LOAD} (up to {max(loads):.1f} on {report['machine']['cpu_count']} "
-            "cores): other jobs shared the machine, so wall times are inflated; the CPU times and the iteration "
-            "counts are the figures to compare with other runs"]
-
 
 def markdown_report(report: dict) -> str:
     sc = report["scaling"]
@@ -273,7 +263,7 @@ def markdown_report(report: dict) -> str:
         f"target M = 100 within 0.3 s (warm): {_verdict(sc['target_M100_under_1s'])}; "
         f"M = 400 within 1 s: {_verdict(sc.get('target_M400_under_1s'))}",
         load_line(report),
-        *_shared_machine_note(report),
+        *shared_machine_note(report),
         f"- accuracy: |rel err| slope against M: {fmt(sc['h_error_slope'], '.2f')} (O(h^2) expects -2)",
     ]
     lines += section("Where the Newton iterations go", report["observations"])

@@ -334,7 +334,7 @@ def main(argv=None) -> int:
     import os
     import signal as _signal
 
-    from .output.interrupts import exit_code_of, signal_name_of, terminate_as_interrupt
+    from .output.interrupts import exit_code_of, interrupt_behind, signal_name_of, terminate_as_interrupt
     from .solve.continuation import ContinuationFailure
 
     previous = {sig: _signal.getsignal(sig) for sig in (_signal.SIGINT, _signal.SIGTERM)}
@@ -376,6 +376,10 @@ def main(argv=None) -> int:
         sys.stderr.write("error: out of memory; lower --resolution\n")
         return EXIT_INTERNAL
     except Exception as exc:  # noqa: BLE001  (one line, never a traceback; DDG_TRACEBACK=1 shows it)
+        interrupt = interrupt_behind(exc)
+        if interrupt is not None:  # a signal that arrived inside compiled code
+            sys.stderr.write(f"error: interrupted by {signal_name_of(interrupt)}\n")
+            return exit_code_of(interrupt)
         if os.environ.get("DDG_TRACEBACK"):
             raise
         sys.stderr.write(f"error: internal error: {type(exc).__name__}: {_one_line(exc)} "

@@ -109,3 +109,21 @@ def test_sigkill_leaves_the_steps_so_far_and_a_folder_marked_running(tmp_path):
     assert summary["scene"]["width_ratio"] == pytest.approx(0.1) and summary["scene"]["resolution"] == 400
     assert len(rows) >= 5 and all(r["energy"] != "" for r in rows)  # whole rows: flushed one at a time
     assert not (out / "branches.csv").exists()  # nothing of the earlier run is left
+
+
+def test_a_signal_inside_compiled_code_is_an_interrupt_not_an_internal_error():
+    """A signal handler that raises while a numba dispatcher is on the stack surfaces as
+    SystemError('... returned a result with an exception set') with the interrupt as its context
+    (seen in CI: exit 1 instead of 143 during threshold location)."""
+    from ddg.output.interrupts import RunInterrupted, interrupt_behind
+
+    signal_raised = RunInterrupted("SIGTERM")
+    try:
+        try:
+            raise signal_raised
+        except KeyboardInterrupt:
+            raise SystemError("CPUDispatcher(<function rod_frames>) returned a result with an exception set")
+    except SystemError as wrapped:
+        assert interrupt_behind(wrapped) is signal_raised
+    assert interrupt_behind(ValueError("a real error")) is None
+    assert interrupt_behind(SystemError("no interrupt behind it")) is None

@@ -34,6 +34,23 @@ def exit_code_of(exc: BaseException) -> int:
     return exc.exit_code if isinstance(exc, RunInterrupted) else 128 + int(signal.SIGINT)
 
 
+def interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
+    """The KeyboardInterrupt hidden behind an error, if any.
+
+    A signal whose Python handler runs while compiled code (a numba dispatcher, a C extension)
+    is on the stack comes back as SystemError("... returned a result with an exception set")
+    with the interrupt as its __context__; that is an interrupt, not an internal error."""
+    seen = 0
+    while exc is not None and seen < 8:
+        if isinstance(exc, KeyboardInterrupt):
+            return exc
+        if not isinstance(exc, SystemError):
+            return None
+        exc = exc.__cause__ or exc.__context__
+        seen += 1
+    return None
+
+
 def _raise_terminated(signum, frame):
     raise RunInterrupted("SIGTERM")
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Callable, Protocol, Sequence
 
 from ..geometry.strip import LoadingProtocol, Strip
+from ..output.interrupts import interrupt_behind
 from ..solve.probe import SILENT, Probe
 from .results import SimulationResult, finish_summary
 
@@ -146,7 +147,9 @@ def follow(run: Run) -> PathOutcome:
     except KeyboardInterrupt as exc:
         out.interrupted = exc
     except Exception as exc:  # noqa: BLE001  (sorted below: the stepper's failure, or an error re-raised later)
-        if isinstance(exc, stepper.failure):
+        if interrupt_behind(exc) is not None:
+            out.interrupted = interrupt_behind(exc)
+        elif isinstance(exc, stepper.failure):
             out.stopped = stepper.failure_message(exc)
         else:
             out.error = exc
@@ -170,7 +173,10 @@ def execute(run: Run) -> SimulationResult:
         except KeyboardInterrupt as exc:
             out.interrupted = exc
         except Exception as exc:  # noqa: BLE001  (written as status "error", then re-raised)
-            out.error = exc
+            if interrupt_behind(exc) is not None:
+                out.interrupted = interrupt_behind(exc)
+            else:
+                out.error = exc
     run.stepper.summarise(run.summary)
     run.summary["wall_time_s"] = time.perf_counter() - t0
     finish_summary(run.summary, out.rows, path_complete=out.complete, stopped=out.stopped,

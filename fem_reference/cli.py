@@ -127,18 +127,6 @@ def _one_line(text) -> str:
     return " ".join(str(text).split())
 
 
-def _interrupt_behind(exc: BaseException) -> BaseException | None:
-    """The KeyboardInterrupt an exception was raised while handling (e.g. an extension module's
-    ImportError "initialization failed" when Ctrl-C hits its import), if any."""
-    seen = set()
-    while exc is not None and id(exc) not in seen:
-        if isinstance(exc, KeyboardInterrupt):
-            return exc
-        seen.add(id(exc))
-        exc = exc.__cause__ or exc.__context__
-    return None
-
-
 def _interrupted(exc: BaseException, args) -> int:
     """One line for a run stopped by SIGINT/SIGTERM; the exit code 128 + the signal number."""
     from ddg.output.interrupts import exit_code_of, signal_name_of
@@ -176,7 +164,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt as exc:
         return _interrupted(exc, args)
     except Exception as exc:
-        interrupt = _interrupt_behind(exc)
+        from ddg.output.interrupts import interrupt_behind
+
+        interrupt = interrupt_behind(exc)
         if interrupt is not None:
             return _interrupted(interrupt, args)
         folder = getattr(exc, "run_folder", None)

@@ -43,12 +43,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ddg.solve.state import SYMMETRY_TOLERANCE, phase_from_measures
+
 from .shell import NaghdiStrip
 from .solver import ITERATION_PHASES, NewtonFailure, Solver  # noqa: F401  (ITERATION_PHASES re-exported)
 
-#: Largest deviation from a symmetry (units of L) for a shape to count as having it (the DDG
-#: models use the same, ddg.analysis.observables.SYMMETRY_TOLERANCE).
-SYMMETRY_TOLERANCE = 1e-4
 DW1_TOLERANCE = 1e-4
 DW2_TOLERANCE = 1e-3
 #: The inextensible cosine guess is used at most at this compression (units of L).
@@ -226,21 +225,20 @@ class Stepper:
 
 # --- observation ------------------------------------------------------------------------------
 def phase_of(model: NaghdiStrip, positions: np.ndarray) -> tuple[str, float, float]:
-    """U, US+, US-, S+, S- (or '' for the flat strip) by the rule of ddg.analysis.observables.phase_label:
-    U if invariant under the half turn about the vertical axis through c, S if invariant under
-    the point reflection through c, US otherwise (to SYMMETRY_TOLERANCE L); + when the highest
-    point of the centerline (material line y = 0) lies in its first half (x < L/2)."""
+    """(phase, half-turn defect, point-reflection defect): the DDG models' rule
+    (ddg.solve.state.phase_from_measures, SYMMETRY_TOLERANCE L) on the shell's measures: the
+    defects from the symmetric mesh (NaghdiStrip.symmetry_defects), the rise from the centerline
+    nodes (highest point of the material line y = 0 in x < L/2 minus that in x > L/2)."""
     mirror, point = model.symmetry_defects(positions)
     compression, _ = model.clamp
-    z = positions[model.centerline_nodes, 2]
-    xs = model.nodes_ref[model.centerline_nodes, 0]
-    if compression == 0.0 and abs(positions[model.centre_node, 2]) < SYMMETRY_TOLERANCE:
-        return "", mirror, point
-    if mirror < SYMMETRY_TOLERANCE:
-        return "U", mirror, point
-    rise = float(np.max(z[xs < 0.5 - 1e-12]) - np.max(z[xs > 0.5 + 1e-12]))
-    sign = "+" if rise >= 0.0 else "-"
-    return ("S" if point < SYMMETRY_TOLERANCE else "US") + sign, mirror, point
+    flat = compression == 0.0 and abs(positions[model.centre_node, 2]) < SYMMETRY_TOLERANCE
+
+    def rise() -> float:
+        z = positions[model.centerline_nodes, 2]
+        xs = model.nodes_ref[model.centerline_nodes, 0]
+        return float(np.max(z[xs < 0.5 - 1e-12]) - np.max(z[xs > 0.5 + 1e-12]))
+
+    return phase_from_measures(mirror, point, rise, flat), mirror, point
 
 
 @dataclass

@@ -380,8 +380,10 @@ def test_ctrl_c_keeps_every_converged_step(fem, monkeypatch, capsys, tmp_path):
 
 
 def test_sigterm_during_threshold_location(fem, monkeypatch, capsys, tmp_path):
-    """SIGTERM (as ddg.output.interrupts raises it) while dW1 is bisected: every recorded step is written,
-    including the unstable-U row the bisection started from; no threshold reported; exit 143."""
+    """SIGTERM (as ddg.output.interrupts raises it) while dW1 is bisected, after the path (the
+    thresholds are steps after it, ddg.protocol; on this 8 x 2 mesh the path stops where the
+    switch from the first unstable U fails): every recorded step is written, including the
+    unstable-U row the bisection's bracket ends at; no threshold reported; exit 143."""
     from ddg.output.interrupts import RunInterrupted
 
     def locate_dw1(*args, **kwargs):
@@ -395,7 +397,7 @@ def test_sigterm_during_threshold_location(fem, monkeypatch, capsys, tmp_path):
     assert summary["status"] == "interrupted" and summary["converged"] is False
     assert summary["dW1_over_L"] is None and summary["dW2_over_L"] is None
     assert len(rows) == summary["recorded_steps"] == 1 + 3 + 2  # rest, 3 compression, 2 shear
-    assert rows[-1].split(",")[0] == "shear"
+    assert rows[-1].split(",")[0] == "shear" and rows[-1].split(",")[7] == "U"  # the unstable U state
 
 
 def test_api_interrupt_attaches_the_result(fem, monkeypatch, tmp_path):

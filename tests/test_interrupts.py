@@ -127,3 +127,10 @@ def test_a_signal_inside_compiled_code_is_an_interrupt_not_an_internal_error():
         assert interrupt_behind(wrapped) is signal_raised
     assert interrupt_behind(ValueError("a real error")) is None
     assert interrupt_behind(SystemError("no interrupt behind it")) is None
+    try:
+        try:
+            raise signal_raised
+        except KeyboardInterrupt:
+            raise ImportError("initialization failed")  # Ctrl-C during an extension module's import
+    except ImportError as wrapped:
+        assert interrupt_behind(wrapped) is signal_raised

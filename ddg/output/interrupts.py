@@ -35,19 +35,18 @@ def exit_code_of(exc: BaseException) -> int:
 
 
 def interrupt_behind(exc: BaseException) -> KeyboardInterrupt | None:
-    """The KeyboardInterrupt hidden behind an error, if any.
+    """The KeyboardInterrupt an error was raised while handling, if any (else None).
 
-    A signal whose Python handler runs while compiled code (a numba dispatcher, a C extension)
-    is on the stack comes back as SystemError("... returned a result with an exception set")
-    with the interrupt as its __context__; that is an interrupt, not an internal error."""
-    seen = 0
-    while exc is not None and seen < 8:
+    A signal whose Python handler runs while compiled code is on the stack comes back as some
+    other error with the interrupt as its __context__: SystemError("... returned a result with an
+    exception set") from a numba dispatcher, ImportError("initialization failed") when Ctrl-C hits
+    an extension module's import. That is an interrupt, not an internal error."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):
             return exc
-        if not isinstance(exc, SystemError):
-            return None
+        seen.add(id(exc))
         exc = exc.__cause__ or exc.__context__
-        seen += 1
     return None
 
 

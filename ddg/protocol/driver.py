@@ -36,10 +36,11 @@ class Loading:
     shear_compression: float  # dL held during the shear stage (the last compression target)
 
     @classmethod
-    def equally_spaced(cls, strip: Strip, protocol: LoadingProtocol) -> "Loading":
+    def equally_spaced(cls, strip: Strip, protocol: LoadingProtocol, in_units_of_length: bool = False) -> "Loading":
         """protocol.compression_steps equal steps to dL, then protocol.shear_steps equal steps to
-        dW (none when dW = 0)."""
-        L = strip.length
+        dW (none when dW = 0); in m, or in units of L with in_units_of_length (a model scaled to
+        L = 1, the FEM shell: dL/L k/n exactly as the ratios give it)."""
+        L = 1.0 if in_units_of_length else strip.length
         dL = protocol.compression_ratio * L
         dW = protocol.shear_sign * protocol.resolved_shear_ratio(strip) * L
         n_shear = protocol.shear_steps if dW != 0.0 else 0
@@ -51,7 +52,9 @@ class Stepper(Protocol):
     """What the driver needs of a solver.
 
     failure: the exception class meaning "this load cannot be reached" (the path stops, the
-    converged part is kept); failure_message(exc) turns it into summary.json's message.
+    converged part is kept); failure_message(exc) turns it into summary.json's message. A
+    failure whose `reached` attribute is a state converged at that load (the FEM shell's unstable
+    U when the branch switch from it fails) has that state recorded before the path stops.
     rest(): the recorded state at dL = dW = 0. advance(state, compression, shear, stage, index):
     the recorded state at the next load (index counts the stage's loads from 0).
     summarise(summary): the stepper's own counts (Newton iterations, phases, folds) into the
@@ -83,7 +86,7 @@ class PathOutcome:
     stopped: str | None = None        # the stepper's failure message
     interrupted: BaseException | None = None
     error: BaseException | None = None
-    stage: str = "compression"        # where the run was when it ended (for the message)
+    stage: str = "the compression stage"  # where the run was when it ended (for the message)
 
 
 @dataclass
@@ -110,6 +113,7 @@ class Run:
     make_result: Callable[[PathOutcome], SimulationResult] | None = None
     close: Sequence[Callable[[], None]] = ()                 # writers and progress bars to close
     probe: Probe = SILENT                                    # told of every recorded step and its wall time
+    started: float | None = None                             # perf_counter() at the run's start (else execute's)
 
 
 def follow(run: Run) -> PathOutcome:
@@ -138,7 +142,7 @@ def follow(run: Run) -> PathOutcome:
         run.summary["H_mid_over_L_compressed"] = out.rows[-1]["H_mid_over_L"]
         if run.on_compressed is not None:
             run.on_compressed(out)
-        out.stage = "shear"
+        out.stage = "the shear stage"
         compression = run.loading.shear_compression
         for k, target in enumerate(run.loading.shear):
             state = stepper.advance(state, compression, target, "shear", k)
@@ -151,6 +155,11 @@ def follow(run: Run) -> PathOutcome:
             out.interrupted = interrupt_behind(exc)
         elif isinstance(exc, stepper.failure):
             out.stopped = stepper.failure_message(exc)
+            if getattr(exc, "reached", None) is not None:  # converged at the load, the step's goal not reached
+                try:
+                    record("shear" if out.stage == "the shear stage" else "compression", exc.reached)
+                except KeyboardInterrupt as late:
+                    out.interrupted = late
         else:
             out.error = exc
     return out
@@ -159,7 +168,7 @@ def follow(run: Run) -> PathOutcome:
 def execute(run: Run) -> SimulationResult:
     """follow(run), then the steps after the path, the summary, the run's files; returns the
     result, or re-raises an interrupt or an error after writing what was computed."""
-    t0 = time.perf_counter()
+    t0 = run.started if run.started is not None else time.perf_counter()
     out = follow(run)
     for closer in run.close:
         closer()
@@ -177,8 +186,8 @@ def execute(run: Run) -> SimulationResult:
                 out.interrupted = interrupt_behind(exc)
             else:
                 out.error = exc
-    run.stepper.summarise(run.summary)
     run.summary["wall_time_s"] = time.perf_counter() - t0
+    run.stepper.summarise(run.summary)
     finish_summary(run.summary, out.rows, path_complete=out.complete, stopped=out.stopped,
                    interrupted=out.interrupted, stage=out.stage, error=out.error)
     result = (run.make_result(out) if run.make_result is not None

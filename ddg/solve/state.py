@@ -10,6 +10,7 @@ between the clamp points; U keeps that symmetry, S the point reflection through 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -79,12 +80,22 @@ def phase_label(model, q: np.ndarray, compression: float, shear: float) -> str:
     where the lobes move towards the clamps.)"""
     L = model.strip.length
     mirror, point = symmetry_defects(model, q, compression, shear)
-    if compression == 0.0 and abs(float(model.midpoint(q)[2])) < SYMMETRY_TOLERANCE * L:
+    flat = compression == 0.0 and abs(float(model.midpoint(q)[2])) < SYMMETRY_TOLERANCE * L
+    return phase_from_measures(mirror, point, lambda: rise(model, q), flat)
+
+
+def phase_from_measures(half_turn_defect: float, point_defect: float, rise_of: Callable[[], float],
+                        flat: bool) -> str:
+    """The phase rule from its measures, for every model (each computes the measures on its own
+    discretisation; the FEM shell from its symmetric mesh): '' for the flat strip, U if the
+    half-turn defect is below SYMMETRY_TOLERANCE, else S if the point-reflection defect is, US
+    otherwise; + when rise_of() (called only then) >= 0."""
+    if flat:
         return ""
-    if mirror < SYMMETRY_TOLERANCE:
+    if half_turn_defect < SYMMETRY_TOLERANCE:
         return "U"
-    sign = "+" if rise(model, q) >= 0.0 else "-"
-    return ("S" if point < SYMMETRY_TOLERANCE else "US") + sign
+    sign = "+" if rise_of() >= 0.0 else "-"
+    return ("S" if point_defect < SYMMETRY_TOLERANCE else "US") + sign
 
 
 def phase_of(model, state: State) -> str:

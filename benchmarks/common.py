@@ -45,6 +45,9 @@ from ddg.output.io import atomic_write_text
 from ddg.solve.continuation import PHASES
 from ddg.solve.probe import Probe
 
+#: how the path benchmarks measure (the "method" of their reports)
+PROBE_METHOD = ("probe (ddg.solve.probe) on the warm call; split under cProfile in a separate warm call, outermost "
+                "calls per category, scaled to the un-profiled wall time (see the module docstring)")
 CHANGED_NOTE = " (CHANGED during the run: runs may mix library versions)"
 
 

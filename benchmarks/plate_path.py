@@ -45,7 +45,8 @@ import argparse
 import functools
 import sys
 
-from benchmarks.common import (Provenance, after_path_text, best_of, category_split, eigen_calls, eigen_paths_text,
+from benchmarks.common import (PROBE_METHOD, Provenance, after_path_text, best_of, category_split, eigen_calls,
+                               eigen_paths_text,
                                shared_machine_note,
                                finish_path_report, fit_slope, fmt, function_key, load_line, machine_section,
                                measure_path, newton_notes, path_slopes, path_timing, ratio, run_in_child, run_notes,
@@ -363,8 +364,7 @@ def build_report(results: list[dict], args, timeout) -> dict:
         "repeat": args.repeat,
         "timeout_s": timeout,
         "split_categories": CATEGORY_LABELS,
-        "method": "probe (ddg.solve.probe) on the warm call; split under cProfile in a separate warm call, outermost "
-                  "calls per category, scaled to the un-profiled wall time (see the module docstring)",
+        "method": PROBE_METHOD,
         "results": results,
     }
 

@@ -37,7 +37,8 @@ import functools
 import math
 import sys
 
-from benchmarks.common import (Provenance, after_path_text, best_of, category_split, eigen_calls, eigen_paths_text,
+from benchmarks.common import (PROBE_METHOD, Provenance, after_path_text, best_of, category_split, eigen_calls,
+                               eigen_paths_text,
                                shared_machine_note,
                                finish_path_report, fit_slope, fmt, load_line, machine_section, markdown_table,
                                measure_path, newton_notes, path_slopes, path_timing, run_in_child, run_notes, section,
@@ -293,8 +294,7 @@ def build_report(results: list[dict], repeat: int, timeout: float | None) -> dic
         "timeout_s": timeout,
         "H_mid_over_L_exact": clamped_elastica_midpoint_height(COMPRESSION_RATIO),
         "split_categories": CATEGORY_LABELS,
-        "method": "probe (ddg.solve.probe) on the warm call; split under cProfile in a separate warm call, outermost "
-                  "calls per category, scaled to the un-profiled wall time (see the module docstring)",
+        "method": PROBE_METHOD,
         "results": results,
     }
 

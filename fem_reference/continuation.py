@@ -84,10 +84,19 @@ class ContinuationOptions:
     #: "secant" (the secant's error is twice the tangent's for equal steps; on the US branch
     #: Newton from it needs 8-16 iterations per step against 7-12), the same states to 1e-8 L.
     predictor: str = "tangent"
+    #: width of the final bracket of dW1 (the midpoint is reported: within half of it) and of dW2
+    #: (its upper end, the first S state found, is reported: within it), units of L; the gold
+    #: runs' mesh studies use 1e-4 for both (fem_reference.gold.GOLD_TOLERANCES)
+    dw1_tolerance: float = DW1_TOLERANCE
+    dw2_tolerance: float = DW2_TOLERANCE
 
     def __post_init__(self):
         if self.predictor not in ("tangent", "secant"):
             raise ValueError(f"predictor = {self.predictor!r}: 'tangent' or 'secant'")
+        for name in ("dw1_tolerance", "dw2_tolerance"):
+            value = getattr(self, name)
+            if not (isinstance(value, float) and 1e-7 <= value <= 1e-2):
+                raise ValueError(f"{name} = {value!r}: a float in [1e-7, 1e-2] (units of L)")
 
 
 @dataclass

@@ -52,6 +52,80 @@ def extrapolate(values: np.ndarray, resolutions, default_order=2.0):
     return richardson(values[-2], values[-1], r, p), p
 
 
+#: Observed orders accepted as asymptotic by `estimate` (P2 elements: about 2 for displacements;
+#: a threshold, the zero of an eigenvalue, may converge at up to twice that).
+ASYMPTOTIC_ORDERS = (1.0, 4.0)
+#: Roache's safety factor of the grid convergence index for a three-mesh study.
+GCI_SAFETY = 1.25
+
+
+def estimate(values, resolutions, tolerance: float = 0.0) -> dict | None:
+    """The converged value of one quantity from its values on meshes `resolutions` (elements
+    along L, increasing; None or nan where a mesh did not give it), with an honest error bar.
+
+    With the finest three meshes' differences d1 = f2 - f1, d2 = f3 - f2 of one sign, shrinking,
+    and the observed order p = log(d1/d2)/log(r) in ASYMPTOTIC_ORDERS: the Richardson
+    extrapolation f3 + d2/(r^p - 1), error bar GCI_SAFETY |d2|/(r^p - 1) (Roache's grid
+    convergence index of the finest mesh), asymptotic True. Otherwise the finest value, error bar
+    |d2| while the differences shrink and 3 max(|d1|, |d2|) when they do not, asymptotic False
+    (two meshes: the spread |d2|; one: no error bar). `tolerance` (the bisection bracket of a
+    threshold) is added to the error bar. None without any value."""
+    pairs = [(int(n), float(v)) for n, v in zip(resolutions, values) if v is not None and np.isfinite(v)]
+    if not pairs:
+        return None
+    ns, fs = [n for n, _ in pairs], [f for _, f in pairs]
+    out = {"value": fs[-1], "error_bar": None, "order": None, "asymptotic": False, "finest": fs[-1],
+           "meshes": ns, "basis": "one mesh: no error bar"}
+    if len(fs) == 2:
+        out.update(error_bar=abs(fs[1] - fs[0]) + tolerance, basis="two meshes: the finest value, the spread")
+    if len(fs) >= 3:
+        (n1, n2, n3), (f1, f2, f3) = ns[-3:], fs[-3:]
+        d1, d2 = f2 - f1, f3 - f2
+        r = n3 / n2
+        shrinking = abs(d2) < abs(d1)
+        p = math.log(abs(d1 / d2)) / math.log(n2 / n1) if d1 * d2 > 0 and shrinking else None
+        if p is not None and ASYMPTOTIC_ORDERS[0] <= p <= ASYMPTOTIC_ORDERS[1]:
+            out.update(value=f3 + d2 / (r**p - 1.0), error_bar=GCI_SAFETY * abs(d2) / (r**p - 1.0) + tolerance,
+                       order=p, asymptotic=True, basis="Richardson, observed order, grid convergence index")
+        else:
+            why = ("differences of one sign, order outside [1, 4]" if p is not None
+                   else "differences change sign" if d1 * d2 <= 0 and shrinking else "differences do not shrink")
+            spread = abs(d2) if shrinking else 3.0 * max(abs(d1), abs(d2))
+            out.update(error_bar=spread + tolerance, order=p, basis=f"not asymptotic ({why}): the finest value")
+    return out
+
+
+def study_estimates(runs, resolutions, band: float = 0.02) -> dict:
+    """estimate() of dW1, dW2 (with the runs' bisection tolerances), H_mid after compression and
+    H_mid(dW) on the common recorded grid of the runs that reached the shear stage; the curve's
+    largest error bar away from the thresholds (|dW - dW_i| > band)."""
+    def tolerance(key):
+        return max(float((r.summary.get("threshold_tolerances_over_L") or {}).get(key) or 0.0) for r in runs)
+
+    dw1 = estimate([r.summary["dW1_over_L"] for r in runs], resolutions, 0.5 * tolerance("dW1"))
+    dw2 = estimate([r.summary["dW2_over_L"] for r in runs], resolutions, tolerance("dW2"))
+    out = {"dW1": dw1, "dW2": dw2,
+           "H_mid_compressed": estimate([r.summary["H_mid_over_L_compressed"] for r in runs], resolutions)}
+    sheared = [(n, r) for n, r in zip(resolutions, runs) if any(row["stage"] == "shear" for row in r.rows)]
+    if len(sheared) >= 2:
+        resolutions, runs = [n for n, _ in sheared], [r for _, r in sheared]
+        rows, _ = summarise(runs, resolutions)
+        grid = sorted({row["dW_over_L"] for row in rows})
+        curve = []
+        for x in grid:
+            values = [next(row["H_mid_over_L"] for row in rows if row["resolution"] == n and row["dW_over_L"] == x)
+                      for n in resolutions]
+            e = estimate(values, resolutions)
+            curve.append({"dW_over_L": x, **{k: e[k] for k in ("value", "error_bar", "order", "asymptotic")}})
+        away = [c for c in curve if _away(np.array([c["dW_over_L"]]), *(e["value"] if e else None for e in (dw1, dw2)),
+                                          margin=band)[0]]
+        out["H_mid_curve"] = curve
+        out["H_mid_curve_away"] = {"band_over_L": band, "points": len(away),
+                                   "asymptotic_points": sum(c["asymptotic"] for c in away),
+                                   "max_error_bar": max((c["error_bar"] for c in away), default=None)}
+    return out
+
+
 #: Meshes of one convergence study: at least 2 (Richardson extrapolation needs two; one mesh
 #: would report zero errors), at most 6 (each is a whole path, 5-20 minutes at 60-120 elements).
 MIN_MESHES, MAX_MESHES = 2, 6

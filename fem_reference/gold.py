@@ -1,11 +1,16 @@
 """Gold data: the FEM reference on the paper's scenes (section 4: dL/L in {1/2, 1/4} x W/L in
-{1/20, 1/12, 1/6, 1/3, 1/2}), `python -m fem_reference gold --out data/fem_gold [--only NAME ...]`.
+{1/20, 1/12, 1/6, 1/3, 1/2}) with error bars from a mesh study,
+`python -m fem_reference gold --out data/fem_gold [--only NAME ...] [--resolution N] [--levels K]`.
 
-Each scene goes to OUT/<name>/ (path.csv, summary.json, centerline.csv; no XDMF to keep the data
-folder small), name = dL<dL/L>_W<W/L> e.g. dL0.5_W0.1667. Scenes are run one at a time, in
-PRIORITY order (the cross-model test needs dL0.5_W0.1667 first), an existing complete scene is
-skipped (delete its folder to rerun), and OUT/index.json lists what exists with mesh, wall time
-and thresholds.
+Every scene is run on LEVELS meshes refined uniformly by REFINEMENT = 1.5 in both directions
+(along L: 40, 60, 90 elements; across W: BASE_ACROSS[W/L] times 1, 1.5, 2.25), each the whole
+path with dW1 and dW2 bisected to GOLD_TOLERANCES, into OUT/<name>/N<along>x<across>/ (path.csv,
+summary.json, centerline.csv; no XDMF to keep the data small), name = dL<dL/L>_W<W/L> e.g.
+dL0.5_W0.1667. After each run the scene's mesh study is rewritten from the runs that exist
+(OUT/<name>/richardson.json, convergence.md, convergence.csv, thresholds.csv: Richardson
+extrapolation with error bars, fem_reference.convergence.estimate), then OUT/index.json and
+OUT/README.md. Resumable run by run: a finished run (status complete or stopped) on the same
+mesh and tolerances is kept; Ctrl-C loses only the run in progress.
 """
 from __future__ import annotations
 
@@ -17,11 +22,34 @@ from ddg.output.io import atomic_write_text
 
 WIDTH_RATIOS = (1 / 20, 1 / 12, 1 / 6, 1 / 3, 1 / 2)
 COMPRESSION_RATIOS = (1 / 2, 1 / 4)
-#: Elements along L for the gold runs (across W: near-isotropic, >= 10 for W/L = 1/6).
-GOLD_RESOLUTION = 60
-#: Scenes run finer: W/L = 1/6 at dL/L = 1/2 is the cross-model reference. Its dW2/L on 60 / 90 / 120
-#: elements: 0.4664 / 0.4336 / 0.4306 (extrapolated 0.4293), dW1/L 0.2564 / 0.2614 / 0.2640 (0.2685).
-GOLD_RESOLUTIONS = {"dL0.5_W0.1667": 120}
+#: The mesh study: LEVELS meshes, each REFINEMENT times finer than the last in both directions.
+REFINEMENT = 1.5
+LEVELS = 3
+#: Elements along L of the coarsest mesh (40, 60, 90 with the defaults).
+BASE_RESOLUTION = 40
+#: Elements across W of the coarsest mesh: multiples of 8, so that 1.5 and 2.25 times them are
+#: even (the mesh must be symmetric); near-isotropic at 40 along L for W/L >= 1/6, finer than
+#: isotropic for the narrow strips (at least 8 across, 4 of them on either side of y = 0).
+BASE_ACROSS = {1 / 20: 8, 1 / 12: 8, 1 / 6: 8, 1 / 3: 16, 1 / 2: 24}
+#: dW1 and dW2 bisection brackets of the gold runs (units of L), a tenth of the smallest change
+#: between meshes of the earlier W/L = 1/6 study (dW2: 0.4336 to 0.4306 from 90 to 120 elements).
+GOLD_TOLERANCES = (1e-4, 1e-4)
+
+
+def mesh_sequence(width_ratio: float, base: int = BASE_RESOLUTION, levels: int = LEVELS) -> list[tuple[int, int]]:
+    """(elements along L, elements across W) of each mesh of a scene's study, coarsest first
+    (counts rounded up to even; exact 1.5 ratios for base a multiple of 8)."""
+    across = next(v for w, v in BASE_ACROSS.items() if abs(w - width_ratio) < 1e-9)
+
+    def even(x: float) -> int:
+        n = int(round(x)) if abs(x - round(x)) < 1e-9 else int(x) + 1
+        return n + (n % 2)
+
+    return [(even(base * REFINEMENT**k), even(across * REFINEMENT**k)) for k in range(levels)]
+
+
+def run_folder_name(along: int, across: int) -> str:
+    return f"N{along}x{across}"
 
 
 def scene_name(compression_ratio: float, width_ratio: float) -> str:
@@ -44,11 +72,12 @@ def _read_summary(path: Path) -> dict | None:
     return summary if isinstance(summary, dict) else None
 
 
-def check_gold_inputs(args) -> list[tuple[str, float, float, int]]:
-    """The scenes to run as (name, dL/L, W/L, resolution), every input checked before any work:
-    --only names known, --resolution within the mesh bounds and memory (mesh.checked_spec) for
-    every selected scene, --out writable. One-line InputError otherwise."""
+def check_gold_inputs(args) -> list[tuple[str, float, float, list[tuple[int, int]]]]:
+    """The scenes to run as (name, dL/L, W/L, meshes), every input checked before any work:
+    --only names known, --levels in 1..4, every mesh of every selected scene within the mesh
+    bounds and memory (mesh.checked_spec), --out writable. One-line InputError otherwise."""
     from ddg.geometry.strip import InputError
+    from ddg.limits import check_integer
     from ddg.output.io import check_output_directory
 
     from .mesh import checked_spec
@@ -60,41 +89,61 @@ def check_gold_inputs(args) -> list[tuple[str, float, float, int]]:
         if unknown:
             raise InputError(f"--only: unknown gold scene(s) {', '.join(map(repr, unknown))}; "
                              f"choose from {', '.join(known)}")
+    levels = check_integer("--levels", LEVELS if args.levels is None else args.levels, 1, 4,
+                           "meshes per scene (3 for Richardson extrapolation with an observed order)")
+    base = BASE_RESOLUTION if args.resolution is None else args.resolution
     selected = []
     for name, dL, W in scenes():
         if only and name not in only:
             continue
-        resolution = GOLD_RESOLUTIONS.get(name, GOLD_RESOLUTION) if args.resolution is None else args.resolution
-        checked_spec(resolution, W, None, "--resolution")
-        selected.append((name, dL, W, int(resolution)))
+        checked_spec(base, W, None, "--resolution")  # the base count's own bounds first
+        meshes = mesh_sequence(W, int(base), levels)
+        for along, across in meshes:
+            checked_spec(along, W, across, f"--resolution (mesh {along} x {across} of the study)")
+        selected.append((name, dL, W, meshes))
     check_output_directory(args.out, "--out")
     return selected
+
+
+def _finished(summary: dict | None, along: int, across: int) -> bool:
+    """A stored run that needs no rerun: finished (complete, or stopped: a rerun stops again), on
+    this mesh, with the gold tolerances."""
+    if not summary or summary.get("status") not in ("complete", "stopped"):
+        return False
+    mesh = summary.get("mesh") or {}
+    tolerances = summary.get("threshold_tolerances_over_L") or {}
+    return (mesh.get("elements_along_L"), mesh.get("elements_across_W")) == (along, across) and \
+        (tolerances.get("dW1"), tolerances.get("dW2")) == GOLD_TOLERANCES
 
 
 def run_gold(args) -> int:
     from ddg.geometry.strip import LoadingProtocol, Strip
 
-    from .api import simulate
+    selected = check_gold_inputs(args)  # before any FEM import
 
-    selected = check_gold_inputs(args)
+    from .api import simulate
+    from .continuation import ContinuationOptions
+
     out = Path(args.out)
+    options = ContinuationOptions(dw1_tolerance=GOLD_TOLERANCES[0], dw2_tolerance=GOLD_TOLERANCES[1])
     status = 0
     try:
-        for name, dL, W, resolution in selected:
-            target = out / name
-            old = _read_summary(target / "summary.json")
-            if old and old.get("converged") and (old.get("scene") or {}).get("resolution") == resolution:
-                continue
-            strip = Strip.from_ratios(W, dL)
-            protocol = LoadingProtocol(dL)
-            t0 = time.perf_counter()
-            result = simulate(strip, protocol, resolution, out=target, fields=False, progress=not args.quiet)
-            if not args.quiet:
-                print(f"{name}: converged {result.converged}, {time.perf_counter() - t0:.0f} s, "
-                      f"dW1/L {result.summary['dW1_over_L']}, dW2/L {result.summary['dW2_over_L']}", flush=True)
-            status = status or (0 if result.converged else 3)
-            write_index(out)
-    finally:  # also after Ctrl-C: the index lists the interrupted scene as not complete
+        for name, dL, W, meshes in selected:
+            for along, across in meshes:
+                target = out / name / run_folder_name(along, across)
+                if _finished(_read_summary(target / "summary.json"), along, across):
+                    continue
+                strip = Strip.from_ratios(W, dL)
+                t0 = time.perf_counter()
+                result = simulate(strip, LoadingProtocol(dL), along, out=target, across=across, fields=False,
+                                  options=options, progress=False)
+                if not args.quiet:
+                    print(f"{name} {along} x {across}: {result.summary['status']}, {time.perf_counter() - t0:.0f} s, "
+                          f"dW1/L {result.summary['dW1_over_L']}, dW2/L {result.summary['dW2_over_L']}", flush=True)
+                status = status or (0 if result.converged else 3)
+                write_scene_study(out / name, meshes)
+                write_index(out)
+    finally:  # also after Ctrl-C: the index lists what is finished
         from ddg.output.interrupts import deferred_signals
 
         with deferred_signals():
@@ -102,22 +151,88 @@ def run_gold(args) -> int:
     return status
 
 
+def scene_runs(folder: Path, meshes=None) -> list[tuple[int, int, Path]]:
+    """The finished runs of one scene folder, coarsest first: (along, across, run folder); only
+    those of `meshes` if given."""
+    found = []
+    for run in sorted(folder.glob("N*x*")):
+        summary = _read_summary(run / "summary.json")
+        mesh = (summary or {}).get("mesh") or {}
+        key = (mesh.get("elements_along_L"), mesh.get("elements_across_W"))
+        if summary and summary.get("status") in ("complete", "stopped") and None not in key:
+            if meshes is None or key in meshes:
+                found.append((int(key[0]), int(key[1]), run))
+    return sorted(found)
+
+
+def write_scene_study(folder: Path, meshes=None) -> dict | None:
+    """The scene's mesh study from its finished runs (fem_reference.convergence): convergence.md,
+    convergence.csv, thresholds.csv and richardson.json in the scene folder; None with no run."""
+    from ddg.geometry.strip import LoadingProtocol, Strip
+    from ddg.output.io import StoredRun
+
+    from .convergence import study_estimates, summarise, write_outputs
+
+    found = scene_runs(folder, meshes)
+    if not found:
+        return None
+    runs = [StoredRun(str(path)) for _, _, path in found]
+    resolutions = [along for along, _, _ in found]
+    scene = runs[-1].summary["scene"]
+    estimates = study_estimates(runs, resolutions)
+    sheared = [(n, r) for n, r in zip(resolutions, runs) if any(row["stage"] == "shear" for row in r.rows)]
+    if len(sheared) >= 2:
+        rows, table = summarise([r for _, r in sheared], [n for n, _ in sheared])
+        write_outputs(folder, rows, table, [r for _, r in sheared], [n for n, _ in sheared],
+                      Strip.from_ratios(scene["width_ratio"], scene["compression_ratio"], scene["slenderness"]),
+                      LoadingProtocol(scene["compression_ratio"]))
+    study = {"scene": {k: scene[k] for k in ("width_ratio", "compression_ratio", "slenderness")},
+             "meshes": [{"along": a, "across": c, "folder": p.name, "status": r.summary["status"],
+                         "n_dof": r.summary["n_dof"], "wall_time_s": r.summary["wall_time_s"],
+                         "newton_iterations": r.summary["newton_iterations"],
+                         "dW1_over_L": r.summary["dW1_over_L"], "dW2_over_L": r.summary["dW2_over_L"],
+                         "H_mid_over_L_compressed": r.summary["H_mid_over_L_compressed"]}
+                        for (a, c, p), r in zip(found, runs)],
+             "refinement_ratio": REFINEMENT, "threshold_tolerances_over_L": list(GOLD_TOLERANCES),
+             **estimates}
+    atomic_write_text(folder / "richardson.json", json.dumps(study, indent=2) + "\n")
+    return study
+
+
+def finest_run(folder: Path) -> Path | None:
+    """The finest finished run of a scene folder (N<along>x<across>), or the folder itself when it
+    holds a single run (the layout before the mesh studies), or None."""
+    found = scene_runs(folder)
+    if found:
+        return found[-1][2]
+    return folder if (folder / "summary.json").exists() else None
+
+
 def write_index(out: Path) -> None:
-    """OUT/index.json: every scene folder with a summary, its mesh, wall time and thresholds."""
+    """OUT/index.json: every scene with its study (richardson.json) or its single run (the layout
+    before the studies), then OUT/README.md."""
     index = {}
     for name, dL, W in scenes():
-        s = _read_summary(out / name / "summary.json")
+        folder = out / name
+        study = _read_summary(folder / "richardson.json")
+        finest = finest_run(folder)
+        s = _read_summary(finest / "summary.json") if finest is not None else None
         if s is None:
             continue
         scene, mesh = s.get("scene") or {}, s.get("mesh") or {}
-        index[name] = {"compression_ratio": dL, "width_ratio": W, "converged": bool(s.get("converged")),
-                       "status": s.get("status"), "message": s.get("message", ""),
-                       "resolution": scene.get("resolution"), "triangles": mesh.get("triangles"),
-                       "n_dof": s.get("n_dof"), "wall_time_s": s.get("wall_time_s"),
-                       "H_mid_over_L_compressed": s.get("H_mid_over_L_compressed"),
-                       "dW1_over_L": s.get("dW1_over_L"), "dW2_over_L": s.get("dW2_over_L"),
-                       "dW_max_over_L": s.get("dW_max_over_L"),
-                       "resolved_up_to_dW_over_L": s.get("resolved_up_to_dW_over_L")}
+        entry = {"compression_ratio": dL, "width_ratio": W, "converged": bool(s.get("converged")),
+                 "status": s.get("status"), "message": s.get("message", ""),
+                 "finest_run": str(finest.relative_to(out)), "resolution": scene.get("resolution"),
+                 "triangles": mesh.get("triangles"), "n_dof": s.get("n_dof"), "wall_time_s": s.get("wall_time_s"),
+                 "H_mid_over_L_compressed": s.get("H_mid_over_L_compressed"),
+                 "dW1_over_L": s.get("dW1_over_L"), "dW2_over_L": s.get("dW2_over_L"),
+                 "dW_max_over_L": s.get("dW_max_over_L"),
+                 "resolved_up_to_dW_over_L": s.get("resolved_up_to_dW_over_L")}
+        if study is not None:
+            entry["study"] = {"meshes": [f"{m['along']}x{m['across']}" for m in study["meshes"]],
+                              "wall_time_s": sum(m["wall_time_s"] or 0.0 for m in study["meshes"]),
+                              **{key: study[key] for key in ("dW1", "dW2", "H_mid_compressed") if key in study}}
+        index[name] = entry
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "index.json", json.dumps(index, indent=2) + "\n")
     write_readme(out, index)
@@ -125,29 +240,28 @@ def write_index(out: Path) -> None:
 
 README_HEAD = """# FEM gold data (fem_reference, nonlinear Naghdi shell)
 
-Regenerate all scenes (one at a time, complete ones are skipped; about 1-2 hours on 2 cores):
+Regenerate (run by run, finished runs are kept; a few hours on one core):
 
-    .venv/bin/python -m fem_reference gold --out data/fem_gold
+    .venv/bin/python -m fem_reference gold --out data/fem_gold [--only dL0.5_W0.1667 ...]
 
-One scene: `--only dL0.5_W0.1667` (names dL<dL/L>_W<W/L>: dL0.5_W0.05, dL0.5_W0.08333,
-dL0.5_W0.1667, dL0.5_W0.3333, dL0.5_W0.5, dL0.25_W0.05, ...). Default mesh: 60 elements along L
-(120 for dL0.5_W0.1667, the cross-model reference, about 22 min), across W near-isotropic and at
-least 60 W/L. Each folder holds path.csv, summary.json and centerline.csv (the DDG output
-contract); `index.json` lists what exists.
+Each scene (names dL<dL/L>_W<W/L>: dL0.5_W0.05, dL0.5_W0.08333, dL0.5_W0.1667, dL0.5_W0.3333,
+dL0.5_W0.5, dL0.25_W0.05, ...) is run on three meshes refined by 1.5 in both directions (40, 60,
+90 elements along L; across W 8/12/18 for W/L <= 1/6, 16/24/36 for 1/3, 24/36/54 for 1/2), dW1
+and dW2 bisected to 1e-4 L. Each run folder N<along>x<across>/ holds path.csv, summary.json and
+centerline.csv (the DDG output contract); the scene folder holds the study: richardson.json,
+convergence.md. A scene folder with a single run at its top level is from before the studies
+(60 elements, dW2 to 1e-3 L).
 
-Mesh convergence of the W/L = 1/6, dL/L = 1/2 scene, whole paths on 60/90/120 elements along L
-(`python -m fem_reference convergence-table --runs ../fem_fine/dL0.5_W0.1667_N60
-../fem_fine/dL0.5_W0.1667_N90 dL0.5_W0.1667 --out ../fem_convergence/dL0.5_W0.1667_full`):
-../fem_convergence/dL0.5_W0.1667_full/convergence.md. Estimated errors of the 120-element gold run
-against the Richardson extrapolation: dW1/L 0.0046 (extrapolated 0.2685), dW2/L 0.0014 (0.4293),
-H_mid/L up to 0.0036 L on the path (one point, dW/L = 0.358 on US, where the observed order is
-unreliable: 0.009 L). The other gold scenes are on 60 elements, where the same scene is off by
-0.012 in dW1/L, 0.037 in dW2/L and up to 0.024 L in H_mid/L: read them as such.
+Error bars (fem_reference.convergence.estimate): with three meshes whose differences shrink
+monotonically and an observed order p in [1, 4], the value is the Richardson extrapolation and
+the error bar 1.25 |f3 - f2| / (r^p - 1) (Roache's grid convergence index on the finest mesh); otherwise
+the value is the finest mesh's, the error bar the spread of the finest two |f3 - f2| (times 3
+when the differences do not shrink), flagged "not asymptotic".
 
 ## What exists (written by the gold command)
 
-| scene | elements along L | triangles | unknowns | H_mid/L compressed | dW1/L | dW2/L | complete | wall time s |
-|---|---:|---:|---:|---:|---:|---:|---|---:|
+| scene | meshes | dW1/L | +- | order | dW2/L | +- | order | finest run | complete | wall time s (all meshes) |
+|---|---|---:|---:|---:|---:|---:|---:|---|---|---:|
 """
 
 
@@ -163,9 +277,21 @@ def write_readme(out: Path, index: dict) -> None:
             return "yes"
         return f"no ({e['status']}): {e['message']}" if e.get("status") else f"no: {e['message']}"
 
-    rows = [f"| {name} | {fmt(e['resolution'], '{}')} | {fmt(e['triangles'], '{}')} | {fmt(e['n_dof'], '{}')} "
-            f"| {fmt(e['H_mid_over_L_compressed'], '{:.6f}')} | {fmt(e['dW1_over_L'])} | {fmt(e['dW2_over_L'])} "
-            f"| {complete(e)} | {fmt(e['wall_time_s'], '{:.0f}')} |" for name, e in index.items()]
+    rows = []
+    for name, e in index.items():
+        study = e.get("study") or {}
+        cells = []
+        for key, single in (("dW1", "dW1_over_L"), ("dW2", "dW2_over_L")):
+            est = study.get(key)
+            if est:
+                flag = "" if est["asymptotic"] else " (not asymptotic)"
+                cells += [fmt(est["value"]), fmt(est["error_bar"]), fmt(est["order"], "{:.2f}") + flag]
+            else:
+                cells += [fmt(e[single]), "-", "-"]
+        meshes = ", ".join(study.get("meshes", [])) or f"{e['resolution']} (single run)"
+        wall = study.get("wall_time_s", e["wall_time_s"])
+        rows.append(f"| {name} | {meshes} | {' | '.join(cells)} | {e['finest_run']} | {complete(e)} | "
+                    f"{fmt(wall, '{:.0f}')} |")
     text = README_HEAD + "\n".join(rows) + "\n"
     if missing:
         text += f"\nNot yet run (one command away, see above): {', '.join(missing)}.\n"

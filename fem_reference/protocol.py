@@ -146,6 +146,7 @@ class ShellStepper:
         if self.options.thresholds:
             summary["threshold_newton_iterations"] = breakdown["threshold dW1"] + breakdown["threshold dW2"]
         summary["branch_switch"] = self.branch_switch
+        summary["threshold_tolerances_over_L"] = {"dW1": self.options.dw1_tolerance, "dW2": self.options.dw2_tolerance}
         summary["wall_time_per_step_s"] = float(np.mean(self.step_times)) if self.step_times else None
         clock = self.solver.clock
         path_wall = summary["wall_time_s"] - summary["build_wall_time_s"]  # the driver's wall time, build excluded
@@ -174,13 +175,14 @@ def threshold_steps(shell: ShellStepper, summary: dict) -> list[AfterStep]:
         if shell.first_unstable_u is None or shell.last_stable_u is None:
             return
         (low, low_lambda), (high_shear, high_lambda) = shell.last_stable_u, shell.first_unstable_u
-        found, _ = continuation.locate_dw1(shell.stepper, low, high_shear, lambdas=(low_lambda, high_lambda))
+        found, _ = continuation.locate_dw1(shell.stepper, low, high_shear, shell.options.dw1_tolerance,
+                                           lambdas=(low_lambda, high_lambda))
         summary["dW1_over_L"] = abs(found)
 
     def dw2() -> None:
         if shell.first_s is None or shell.last_us is None:
             return
-        found, _ = continuation.locate_dw2(shell.stepper, shell.last_us, shell.first_s)
+        found, _ = continuation.locate_dw2(shell.stepper, shell.last_us, shell.first_s, shell.options.dw2_tolerance)
         summary["dW2_over_L"] = abs(found)
 
     return [AfterStep("threshold location", timed(dw1), f"{LOCATING} (dW1, bisection on U)"),

@@ -120,14 +120,21 @@ def test_unknown_counts_and_estimates():
 
 
 def test_default_and_gold_meshes_pass(monkeypatch):
+    """Every mesh of every gold study fits a 16 GiB machine and is refined by exactly 1.5 in both
+    directions from one level to the next (Richardson needs uniform refinement)."""
     import ddg.limits
-    from fem_reference.gold import GOLD_RESOLUTION, GOLD_RESOLUTIONS, WIDTH_RATIOS
+    from fem_reference.gold import REFINEMENT, WIDTH_RATIOS, mesh_sequence
     from fem_reference.mesh import checked_spec
 
     monkeypatch.setattr(ddg.limits, "available_memory_bytes", lambda: 16 * GIB)
     for width in WIDTH_RATIOS:
-        for resolution in {GOLD_RESOLUTION, *GOLD_RESOLUTIONS.values()}:
-            assert checked_spec(resolution, width).nx == resolution
+        meshes = mesh_sequence(width)
+        assert [along for along, _ in meshes] == [40, 60, 90]
+        for (a0, c0), (a1, c1) in zip(meshes, meshes[1:]):
+            assert a1 / a0 == c1 / c0 == REFINEMENT
+        for along, across in meshes:
+            spec = checked_spec(along, width, across)
+            assert (spec.nx, spec.ny) == (along, across)
     assert checked_spec(5, 1 / 6, 3).nx == 6 and checked_spec(5, 1 / 6, 3).ny == 4  # odd rounded up to even
 
 

@@ -1,0 +1,100 @@
+"""The gold data's error bars (fem_reference.convergence.estimate, issue 16 item 1): exact on a
+quantity that converges at a known order, honest where the meshes are not asymptotic.
+
+No dolfinx needed: the estimates are checked on synthetic mesh sequences and on stored run
+folders written here.
+"""
+import json
+import math
+
+import pytest
+
+from fem_reference.convergence import GCI_SAFETY, estimate
+
+MESHES = [40, 60, 90]
+
+
+def converging(exact: float, constant: float, order: float):
+    return [exact + constant * (1.0 / n) ** order for n in MESHES]
+
+
+@pytest.mark.parametrize("order", [1.0, 2.0, 3.0])
+def test_a_quantity_converging_at_order_p_is_extrapolated_exactly(order):
+    e = estimate(converging(0.25, 30.0, order), MESHES)
+    assert e["asymptotic"] and e["order"] == pytest.approx(order, rel=1e-9)
+    assert e["value"] == pytest.approx(0.25, abs=1e-12)
+    # Roache's grid convergence index: 1.25 times the finest mesh's own error
+    fine_error = 30.0 * (1.0 / 90) ** order
+    assert e["error_bar"] == pytest.approx(GCI_SAFETY * fine_error, rel=1e-9)
+    assert abs(e["finest"] - e["value"]) < e["error_bar"]
+
+
+def test_the_bisection_tolerance_is_added_to_the_error_bar():
+    plain, padded = estimate(converging(0.3, 5.0, 2.0), MESHES), estimate(converging(0.3, 5.0, 2.0), MESHES, 1e-4)
+    assert padded["error_bar"] == pytest.approx(plain["error_bar"] + 1e-4)
+
+
+def test_differences_that_change_sign_give_the_finest_value_and_its_spread():
+    e = estimate([0.250, 0.262, 0.259], MESHES)
+    assert not e["asymptotic"] and "change sign" in e["basis"]
+    assert e["value"] == 0.259 and e["error_bar"] == pytest.approx(0.003)
+
+
+def test_differences_that_grow_give_three_times_the_largest():
+    e = estimate([0.250, 0.252, 0.260], MESHES)
+    assert not e["asymptotic"] and "do not shrink" in e["basis"]
+    assert e["error_bar"] == pytest.approx(3 * 0.008)
+
+
+def test_an_order_outside_the_expected_window_is_not_asymptotic():
+    e = estimate(converging(0.25, 30.0, 0.5), MESHES)  # shrinking, one sign, p = 0.5
+    assert not e["asymptotic"] and e["order"] == pytest.approx(0.5) and "outside" in e["basis"]
+    assert e["value"] == e["finest"]
+
+
+def test_fewer_meshes_say_so():
+    two = estimate([0.25, None, 0.26], MESHES)
+    assert two["meshes"] == [40, 90] and two["error_bar"] == pytest.approx(0.01) and not two["asymptotic"]
+    one = estimate([None, math.nan, 0.26], MESHES)
+    assert one["error_bar"] is None and one["basis"].startswith("one mesh")
+    assert estimate([None, None, None], MESHES) is None
+
+
+def _stored_run(folder, along, across, dw1, dw2, heights, width=1 / 6):
+    """A finished gold run folder: summary.json and path.csv with the keys the study reads."""
+    from ddg.output.io import write_path_csv, write_summary_json
+
+    folder.mkdir(parents=True)
+    rows = [{"stage": "compression", "dL_over_L": 0.5, "dW_over_L": 0.0, "H_mid_over_L": heights[0], "phase": "U"}]
+    rows += [{"stage": "shear", "dL_over_L": 0.5, "dW_over_L": 0.1 * k, "H_mid_over_L": h, "phase": "U"}
+             for k, h in enumerate(heights[1:], start=1)]
+    write_path_csv(folder / "path.csv", rows)
+    write_summary_json(folder / "summary.json", {
+        "model": "fem", "status": "complete", "converged": True, "message": "path complete",
+        "scene": {"width_ratio": width, "compression_ratio": 0.5, "slenderness": 1181.1, "resolution": along},
+        "mesh": {"elements_along_L": along, "elements_across_W": across, "triangles": 2 * along * across},
+        "n_dof": 100 * along, "recorded_steps": len(rows), "dW1_over_L": dw1, "dW2_over_L": dw2,
+        "H_mid_over_L_compressed": heights[0], "wall_time_s": float(along), "newton_iterations": along,
+        "threshold_tolerances_over_L": {"dW1": 1e-4, "dW2": 1e-4}})
+
+
+def test_a_scene_study_from_stored_runs(tmp_path):
+    """write_scene_study reads the finished runs of a scene folder and writes richardson.json with
+    the same estimates as estimate() on the runs' numbers, and the finest run is the study's last."""
+    from fem_reference.gold import finest_run, write_scene_study
+
+    scene = tmp_path / "dL0.5_W0.1667"
+    dw1 = converging(0.27, 20.0, 2.0)
+    for (along, across), d1 in zip([(40, 8), (60, 12), (90, 18)], dw1):
+        heights = [0.37 + 1.0 / along**2, 0.36 + 2.0 / along**2, 0.35 + 3.0 / along**2]
+        _stored_run(scene / f"N{along}x{across}", along, across, d1, 0.43, heights)
+    study = write_scene_study(scene)
+    stored = json.loads((scene / "richardson.json").read_text())
+    assert stored["dW1"]["value"] == pytest.approx(0.27, abs=1e-12) and stored["dW1"]["asymptotic"]
+    assert stored["dW1"]["error_bar"] == pytest.approx(estimate(dw1, MESHES, 0.5e-4)["error_bar"])
+    # dW2 equal on every mesh: no observed order, the spread (zero) plus the bisection bracket
+    assert stored["dW2"]["error_bar"] == pytest.approx(1e-4) and not stored["dW2"]["asymptotic"]
+    assert [m["along"] for m in study["meshes"]] == MESHES
+    assert all(point["asymptotic"] for point in stored["H_mid_curve"])
+    assert (scene / "convergence.md").exists()
+    assert finest_run(scene).name == "N90x18"

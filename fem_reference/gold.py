@@ -200,12 +200,14 @@ def write_scene_study(folder: Path, meshes=None) -> dict | None:
 
 
 def finest_run(folder: Path) -> Path | None:
-    """The finest finished run of a scene folder (N<along>x<across>), or the folder itself when it
-    holds a single run (the layout before the mesh studies), or None."""
+    """The finest finished run of a scene folder's study (N<along>x<across>) once the study has
+    LEVELS meshes; before that the single run at the folder's top level (the layout before the
+    studies) where there is one, else the finest run so far; None without any run."""
     found = scene_runs(folder)
-    if found:
+    legacy = (folder / "summary.json").exists()
+    if found and (len(found) >= LEVELS or not legacy):
         return found[-1][2]
-    return folder if (folder / "summary.json").exists() else None
+    return folder if legacy else None
 
 
 def write_index(out: Path) -> None:

@@ -49,8 +49,12 @@ GoldCurve = StoredRun
 
 
 def load_gold(compression_ratio: float, width_ratio: float, root: Path = FEM_GOLD) -> GoldCurve | None:
-    directory = Path(root) / gold_name(compression_ratio, width_ratio)
-    if not (directory / "summary.json").exists() or not (directory / "path.csv").exists():
+    """The scene's FEM reference run: the finest mesh of its study (fem_reference.gold.finest_run),
+    or None."""
+    from fem_reference.gold import finest_run
+
+    directory = finest_run(Path(root) / gold_name(compression_ratio, width_ratio))
+    if directory is None or not (directory / "path.csv").exists():
         return None
     return GoldCurve(directory)
 

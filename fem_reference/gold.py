@@ -200,14 +200,14 @@ def write_scene_study(folder: Path, meshes=None) -> dict | None:
 
 
 def finest_run(folder: Path) -> Path | None:
-    """The finest finished run of a scene folder's study (N<along>x<across>) once the study has
-    LEVELS meshes; before that the single run at the folder's top level (the layout before the
-    studies) where there is one, else the finest run so far; None without any run."""
+    """The scene's reference run: the single run at the folder's top level where there is one
+    (the layout before the mesh studies, kept as the validation's reference until the claims
+    compare extrapolated values, issue 16 item 4), else the finest finished run of the study
+    (N<along>x<across>), else None."""
+    if (folder / "summary.json").exists():
+        return folder
     found = scene_runs(folder)
-    legacy = (folder / "summary.json").exists()
-    if found and (len(found) >= LEVELS or not legacy):
-        return found[-1][2]
-    return folder if legacy else None
+    return found[-1][2] if found else None
 
 
 def write_index(out: Path) -> None:

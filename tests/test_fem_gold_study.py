@@ -98,3 +98,5 @@ def test_a_scene_study_from_stored_runs(tmp_path):
     assert all(point["asymptotic"] for point in stored["H_mid_curve"])
     assert (scene / "convergence.md").exists()
     assert finest_run(scene).name == "N90x18"
+    (scene / "summary.json").write_text("{}")  # a single run of the layout before the studies
+    assert finest_run(scene) == scene

@@ -118,7 +118,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--only", nargs="*", default=None,
                    help="scene names to run (e.g. dL0.5_W0.1667); default all")
     p.add_argument("--resolution", type=int, default=None,
-                   help="elements along L of the coarsest mesh of each scene's study, 4..400 (default 40)")
+                   help="elements along L of the coarsest mesh of each scene's study, 4..400 (default 64)")
     p.add_argument("--levels", type=int, default=None, help="meshes per scene, each 1.5 times finer, 1..4 (default 3)")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_gold)

@@ -3,7 +3,7 @@
 `python -m fem_reference gold --out data/fem_gold [--only NAME ...] [--resolution N] [--levels K]`.
 
 Every scene is run on LEVELS meshes refined uniformly by REFINEMENT = 1.5 in both directions
-(along L: 40, 60, 90 elements; across W: BASE_ACROSS[W/L] times 1, 1.5, 2.25), each the whole
+(along L: 64, 96, 144 elements; across W: BASE_ACROSS[W/L] times 1, 1.5, 2.25), each the whole
 path with dW1 and dW2 bisected to GOLD_TOLERANCES, into OUT/<name>/N<along>x<across>/ (path.csv,
 summary.json, centerline.csv; no XDMF to keep the data small), name = dL<dL/L>_W<W/L> e.g.
 dL0.5_W0.1667. After each run the scene's mesh study is rewritten from the runs that exist
@@ -25,11 +25,14 @@ COMPRESSION_RATIOS = (1 / 2, 1 / 4)
 #: The mesh study: LEVELS meshes, each REFINEMENT times finer than the last in both directions.
 REFINEMENT = 1.5
 LEVELS = 3
-#: Elements along L of the coarsest mesh (40, 60, 90 with the defaults).
-BASE_RESOLUTION = 40
+#: Elements along L of the coarsest mesh (64, 96, 144 with the defaults; a multiple of 8 keeps
+#: the ratios exact). 40 is not in the asymptotic range of the thresholds: at W/L = 1/6, dL/L = 1/2
+#: the meshes 40 x 8, 60 x 12, 90 x 18 gave dW1/L 0.2585, 0.2570, 0.2615 and dW2/L 0.4851,
+#: 0.4195, 0.4360, neither monotone (those runs are kept in data/fem_gold/dL0.5_W0.1667).
+BASE_RESOLUTION = 64
 #: Elements across W of the coarsest mesh: multiples of 8, so that 1.5 and 2.25 times them are
-#: even (the mesh must be symmetric); near-isotropic at 40 along L for W/L >= 1/6, finer than
-#: isotropic for the narrow strips (at least 8 across, 4 of them on either side of y = 0).
+#: even (the mesh must be symmetric); h_y = W/8 .. W/24 (at 64 along L: 0.4 to 1.3 times h_x,
+#: at least 8 across, 4 of them on either side of y = 0).
 BASE_ACROSS = {1 / 20: 8, 1 / 12: 8, 1 / 6: 8, 1 / 3: 16, 1 / 2: 24}
 #: dW1 and dW2 bisection brackets of the gold runs (units of L), a tenth of the smallest change
 #: between meshes of the earlier W/L = 1/6 study (dW2: 0.4336 to 0.4306 from 90 to 120 elements).
@@ -247,12 +250,14 @@ Regenerate (run by run, finished runs are kept; a few hours on one core):
     .venv/bin/python -m fem_reference gold --out data/fem_gold [--only dL0.5_W0.1667 ...]
 
 Each scene (names dL<dL/L>_W<W/L>: dL0.5_W0.05, dL0.5_W0.08333, dL0.5_W0.1667, dL0.5_W0.3333,
-dL0.5_W0.5, dL0.25_W0.05, ...) is run on three meshes refined by 1.5 in both directions (40, 60,
-90 elements along L; across W 8/12/18 for W/L <= 1/6, 16/24/36 for 1/3, 24/36/54 for 1/2), dW1
+dL0.5_W0.5, dL0.25_W0.05, ...) is run on three meshes refined by 1.5 in both directions (64, 96,
+144 elements along L; across W 8/12/18 for W/L <= 1/6, 16/24/36 for 1/3, 24/36/54 for 1/2), dW1
 and dW2 bisected to 1e-4 L. Each run folder N<along>x<across>/ holds path.csv, summary.json and
 centerline.csv (the DDG output contract); the scene folder holds the study: richardson.json,
 convergence.md. A scene folder with a single run at its top level is from before the studies
-(60 elements, dW2 to 1e-3 L).
+(60 elements, dW2 to 1e-3 L) and stays the validation's reference until the claims compare
+extrapolated values. Runs of other meshes in a scene folder are kept as evidence (W/L = 1/6:
+40 x 8, 60 x 12, 90 x 18, not asymptotic: convergence_40_60_90.md) and are not part of its study.
 
 Error bars (fem_reference.convergence.estimate): with three meshes whose differences shrink
 monotonically and an observed order p in [1, 4], the value is the Richardson extrapolation and

@@ -129,7 +129,7 @@ def test_default_and_gold_meshes_pass(monkeypatch):
     monkeypatch.setattr(ddg.limits, "available_memory_bytes", lambda: 16 * GIB)
     for width in WIDTH_RATIOS:
         meshes = mesh_sequence(width)
-        assert [along for along, _ in meshes] == [40, 60, 90]
+        assert [along for along, _ in meshes] == [64, 96, 144]
         for (a0, c0), (a1, c1) in zip(meshes, meshes[1:]):
             assert a1 / a0 == c1 / c0 == REFINEMENT
         for along, across in meshes:

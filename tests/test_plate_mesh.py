@@ -479,3 +479,39 @@ def test_memory_estimate_from_the_size_matches_the_mesh(width):
         assert estimates[-1] == pytest.approx(actual, rel=0.1)
     assert 4.0 < estimates[1] / estimates[0] < 4.0**1.5 * 1.1
     assert plate_memory_estimate_bytes(LENGTH, width, 2000, unstructured=True) > estimates[0]
+
+
+# --------------------------------------------------------------------------- equilateral structured mesh
+@pytest.mark.parametrize("width", WIDTHS)
+@pytest.mark.parametrize("target", TARGETS)
+def test_equilateral_mesh_is_exactly_equilateral_between_its_end_strips(width, target):
+    """structured_mesh(..., equilateral=True): the same rows as the default mesh, columns
+    sqrt(3)/2 h_y apart about a regular column at L/2, the clamp columns at -c, c, L - c, L + c
+    (c half a spacing), the remainder of L in the strip between a clamp column and the lattice
+    (between 1/2 and 3/2 spacings); symmetric under the half turn about the centre; the centre a
+    node; every triangle away from those strips equilateral."""
+    mesh = structured_mesh(LENGTH, width, target, equilateral=True)
+    default = structured_mesh(LENGTH, width, target)
+    n_y = rows(mesh)
+    assert n_y == rows(default)
+    x = columns(mesh)
+    h_x = 0.5 * math.sqrt(3.0) * width / n_y
+    c = mesh.clamp_depth
+    assert c == pytest.approx(0.5 * h_x, rel=1e-12)
+    assert x[:2] == pytest.approx([-c, c], abs=ROUNDOFF) and x[-2:] == pytest.approx([LENGTH - c, LENGTH + c],
+                                                                                       abs=ROUNDOFF)
+    assert np.diff(x[2:-2]) == pytest.approx(np.full(len(x) - 5, h_x), rel=1e-9)
+    assert 0.5 * h_x - ROUNDOFF <= x[2] - x[1] < 1.5 * h_x
+    assert x[2] - x[1] == pytest.approx(x[-2] - x[-3], abs=ROUNDOFF)
+    assert len(x) % 2 == 1 and x[len(x) // 2] == pytest.approx(0.5 * LENGTH, abs=ROUNDOFF)
+    # the half turn (x, y) -> (L - x, -y) maps the node set onto itself
+    turned = np.column_stack([LENGTH - mesh.nodes[:, 0], -mesh.nodes[:, 1]])
+    key = lambda p: set(map(tuple, np.round(p / ROUNDOFF / LENGTH).astype(np.int64)))  # noqa: E731
+    assert key(turned) == key(mesh.nodes)
+    # equilateral: all three sides equal on every triangle whose nodes lie within the lattice
+    p = mesh.nodes[mesh.triangles]
+    inside = np.all((p[:, :, 0] >= x[2] - ROUNDOFF) & (p[:, :, 0] <= x[-3] + ROUNDOFF), axis=1)
+    sides = np.linalg.norm(p - np.roll(p, 1, axis=1), axis=2)
+    # (the edge rows hold the half-size triangles: those with a node on y = +-W/2 are left out)
+    interior = inside & np.all(np.abs(p[:, :, 1]) < 0.5 * width - 0.4 * width / n_y, axis=1)
+    assert np.allclose(sides[interior], width / n_y, rtol=1e-9)

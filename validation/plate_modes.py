@@ -1,8 +1,9 @@
 """Where the DDG plate's first-order error can come from: its energies on exact smooth
 deformations, mode by mode, interior against edge rows (issue 16 item 3, first measurement).
 
-`python -m validation.plate_modes [--out data/plate_modes]` imposes on the structured mesh
-(ddg.geometry.plate_mesh.structured_mesh) one deformation at a time, each small enough to be
+`python -m validation.plate_modes [--out data/plate_modes]` imposes on the structured meshes
+(ddg.geometry.plate_mesh.structured_mesh: the default, and the exactly equilateral one) one
+deformation at a time, each small enough to be
 linear (curvature 0.01/L, strain 1e-4), and compares the energy the plate's terms give
 (hinges, Eq. 11b; edge springs, Eq. 11a) with the continuum energy the plate stands for (bending
 stiffness D = E b^3/12 with bending Poisson ratio -1/3; membrane E b with Poisson ratio 1/3;
@@ -42,14 +43,18 @@ STRAIN = 1e-4
 
 
 def _window(model: PlateModel, points: np.ndarray) -> tuple[np.ndarray, float]:
-    """Points (element midpoints) in whole column periods around the middle of the strip, and
-    the window's length along x."""
+    """Weights of points (element midpoints) in whole column periods around the middle of the
+    strip (1 inside, 1/2 on a bound: the diagonals' midpoints lie on them), and the window's
+    length along x."""
     columns = np.unique(np.round(model.mesh.nodes[:, 0], 12))
-    spacing = columns[1] - columns[0]
-    first = len(columns) // 4 * 2
+    first = 2 * (len(columns) // 8)  # from about L/4 to about 3 L/4
     last = first + 2 * (len(columns) // 4)
-    xa, xb = columns[first] - 0.5 * spacing, columns[last] - 0.5 * spacing
-    return (points[:, 0] >= xa) & (points[:, 0] < xb), xb - xa
+    xa, xb = 0.5 * (columns[first - 1] + columns[first]), 0.5 * (columns[last - 1] + columns[last])
+    tol = 1e-9 * model.strip.length
+    x = points[:, 0]
+    weight = ((x > xa + tol) & (x < xb - tol)).astype(float)
+    weight[(np.abs(x - xa) <= tol) | (np.abs(x - xb) <= tol)] = 0.5
+    return weight, xb - xa
 
 
 def bending_modes(L: float, W: float) -> dict:
@@ -87,17 +92,25 @@ def membrane_modes() -> dict:
     return {name: (eps, density(eps)) for name, eps in modes.items()}
 
 
-def measure(width_ratio: float, triangles: int) -> list[dict]:
+#: The structured meshes compared: the default (equally spaced columns, counts rounded) and the
+#: exactly equilateral one (ddg.geometry.plate_mesh.equilateral_columns).
+MESHES = ("structured", "equilateral")
+
+
+def measure(width_ratio: float, triangles: int, mesh_kind: str = "structured") -> list[dict]:
+    from ddg.geometry.plate_mesh import structured_mesh
+
     strip = Strip.from_ratios(width_ratio, 0.5)
     L, W, E, b = strip.length, strip.width, strip.young_modulus, strip.thickness
     D = E * b**3 / 12.0
-    model = PlateModel(strip, triangles)
+    model = PlateModel(strip, mesh=structured_mesh(L, W, triangles, equilateral=mesh_kind == "equilateral"))
     mesh, X = model.mesh, model.mesh.nodes
     rows_across = len(np.unique(np.round(X[:, 1], 12))) - 1
     columns = np.unique(np.round(X[:, 0], 12))
     # column spacing over that of equilateral triangles: the structured mesh rounds its counts
     aspect = (columns[1] - columns[0]) / (0.5 * math.sqrt(3.0) * 2.0 * W / rows_across)
-    base = {"width_ratio": width_ratio, "triangles": mesh.triangle_count, "h_over_W": 2.0 / rows_across,
+    base = {"mesh": mesh_kind, "width_ratio": width_ratio, "triangles": mesh.triangle_count,
+            "h_over_W": 2.0 / rows_across,
             "aspect_over_equilateral": aspect}
     out = []
     # the interior band: whole rows, |y| < c with c the row boundary nearest W/4; elements whose
@@ -113,14 +126,19 @@ def measure(width_ratio: float, triangles: int) -> list[dict]:
     hinge_mid = 0.5 * (X[hinge_nodes[:, 0]] + X[hinge_nodes[:, 1]])
     in_window, length = _window(model, hinge_mid)
     interior = interior_weight(hinge_mid)
+    on_edge = np.abs(np.abs(X[:, 1]) - 0.5 * W) < 1e-12 * W
+    boundary = on_edge[hinge_nodes[:, 0]] | on_edge[hinge_nodes[:, 1]]  # hinges touching a free edge
     k = CURVATURE / L
     for name, (deform, density) in bending_modes(L, W).items():
         energy = hinge_bending_energy(deform(X), mesh.triangles, mesh.hinge_triangles, model.hinge_stiffness,
                                       gradient=False)[0]
         unit = density * D * k**2 * length
-        out.append({**base, "mode": name, "energy": "bending (hinges)",
-                    "ratio_whole_width": energy[in_window].sum() / (unit * W),
-                    "ratio_interior": (energy * interior)[in_window].sum() / (unit * 2.0 * cut)})
+        whole = (energy * in_window).sum() / (unit * W)
+        at_edges = (energy * in_window * boundary).sum() / (unit * W)
+        out.append({**base, "mode": name, "energy": "bending (hinges)", "ratio_whole_width": whole,
+                    "ratio_interior": (energy * interior * in_window).sum() / (unit * 2.0 * cut),
+                    # the factor on the free-edge hinges that would make the whole width exact
+                    "edge_hinge_factor_to_exact": (1.0 - (whole - at_edges)) / at_edges})
     edge_mid = 0.5 * (X[mesh.edges[:, 0]] + X[mesh.edges[:, 1]])
     in_window, length = _window(model, edge_mid)
     interior = interior_weight(edge_mid)
@@ -131,8 +149,9 @@ def measure(width_ratio: float, triangles: int) -> list[dict]:
         energy = 0.5 * model.stretch_stiffness * (stretched - model.rest_edge_lengths) ** 2
         unit = density * E * b * STRAIN**2 * length
         out.append({**base, "mode": name, "energy": "stretching (edge springs)",
-                    "ratio_whole_width": energy[in_window].sum() / (unit * W),
-                    "ratio_interior": (energy * interior)[in_window].sum() / (unit * 2.0 * cut)})
+                    "ratio_whole_width": (energy * in_window).sum() / (unit * W),
+                    "ratio_interior": (energy * interior * in_window).sum() / (unit * 2.0 * cut),
+                    "edge_hinge_factor_to_exact": math.nan})
     return out
 
 
@@ -144,19 +163,20 @@ def fitted_order(h: np.ndarray, error: np.ndarray) -> float:
     return float(np.polyfit(np.log(h[keep]), np.log(np.abs(error[keep])), 1)[0])
 
 
-def study(widths=WIDTH_RATIOS, triangles=TRIANGLES) -> tuple[list[dict], list[dict]]:
-    rows = [row for w in widths for t in triangles for row in measure(w, t)]
+def study(widths=WIDTH_RATIOS, triangles=TRIANGLES, meshes=MESHES) -> tuple[list[dict], list[dict]]:
+    rows = [row for kind in meshes for w in widths for t in triangles for row in measure(w, t, kind)]
     orders = []
-    for w in widths:
-        for mode in dict.fromkeys(r["mode"] for r in rows):
-            sel = [r for r in rows if r["width_ratio"] == w and r["mode"] == mode]
-            h = np.array([r["h_over_W"] for r in sel])
-            whole = np.array([r["ratio_whole_width"] for r in sel])
-            inner = np.array([r["ratio_interior"] for r in sel])
-            orders.append({"width_ratio": w, "mode": mode, "energy": sel[0]["energy"],
-                           "finest_whole_width": whole[-1], "finest_interior": inner[-1],
-                           "order_whole_width": fitted_order(h, 1.0 - whole),
-                           "order_interior": fitted_order(h, 1.0 - inner)})
+    for kind in meshes:
+        for w in widths:
+            for mode in dict.fromkeys(r["mode"] for r in rows):
+                sel = [r for r in rows if r["mesh"] == kind and r["width_ratio"] == w and r["mode"] == mode]
+                h = np.array([r["h_over_W"] for r in sel])
+                whole = np.array([r["ratio_whole_width"] for r in sel])
+                inner = np.array([r["ratio_interior"] for r in sel])
+                orders.append({"mesh": kind, "width_ratio": w, "mode": mode, "energy": sel[0]["energy"],
+                               "finest_whole_width": whole[-1], "finest_interior": inner[-1],
+                               "order_whole_width": fitted_order(h, 1.0 - whole),
+                               "order_interior": fitted_order(h, 1.0 - inner)})
     return rows, orders
 
 
@@ -173,19 +193,22 @@ def write(out: Path, rows: list[dict], orders: list[dict]) -> None:
              "Orders: "
              "least-squares slope of log|1 - ratio| against log h over "
              f"{', '.join(str(t) for t in TRIANGLES)} target triangles (nan: exact on every mesh).", "",
-             "| W/L | mode | energy | ratio, whole width (finest) | ratio, interior (finest) | order, whole width "
-             "| order, interior |", "|---|---|---|---:|---:|---:|---:|"]
+             "| mesh | W/L | mode | energy | ratio, whole width (finest) | ratio, interior (finest) "
+             "| order, whole width | order, interior |", "|---|---|---|---|---:|---:|---:|---:|"]
     for o in orders:
-        lines.append(f"| {o['width_ratio']:.4g} | {o['mode']} | {o['energy']} | {o['finest_whole_width']:.4f} | "
-                     f"{o['finest_interior']:.4f} | {o['order_whole_width']:.2f} | {o['order_interior']:.2f} |")
+        lines.append(f"| {o['mesh']} | {o['width_ratio']:.4g} | {o['mode']} | {o['energy']} | "
+                     f"{o['finest_whole_width']:.4f} | {o['finest_interior']:.4f} | {o['order_whole_width']:.2f} | "
+                     f"{o['order_interior']:.2f} |")
     lines += ["", "Per mesh (aspect: column spacing over that of equilateral triangles, from the rounding of the "
               "structured mesh's counts):", "",
-              "| W/L | triangles | h_y/W | aspect | mode | whole width | interior |",
-              "|---|---:|---:|---:|---|---:|---:|"]
+              "| mesh | W/L | triangles | h_y/W | aspect | mode | whole width | interior | factor on free-edge hinges "
+              "for an exact whole width |",
+              "|---|---|---:|---:|---:|---|---:|---:|---:|"]
     for r in rows:
-        lines.append(f"| {r['width_ratio']:.4g} | {r['triangles']} | {r['h_over_W']:.4f} | "
+        factor = r["edge_hinge_factor_to_exact"]
+        lines.append(f"| {r['mesh']} | {r['width_ratio']:.4g} | {r['triangles']} | {r['h_over_W']:.4f} | "
                      f"{r['aspect_over_equilateral']:.4f} | {r['mode']} | {r['ratio_whole_width']:.5f} | "
-                     f"{r['ratio_interior']:.5f} |")
+                     f"{r['ratio_interior']:.5f} | {'-' if math.isnan(factor) else f'{factor:.3f}'} |")
     atomic_write_text(out / "modes.md", "\n".join(lines) + "\n")
 
 
@@ -196,7 +219,7 @@ def main(argv=None) -> int:
     rows, orders = study()
     write(Path(args.out), rows, orders)
     for o in orders:
-        print(f"W/L {o['width_ratio']:.4g} {o['mode']:17s} whole {o['finest_whole_width']:.4f} "
+        print(f"{o['mesh']:11s} W/L {o['width_ratio']:.4g} {o['mode']:17s} whole {o['finest_whole_width']:.4f} "
               f"(order {o['order_whole_width']:.2f}) interior {o['finest_interior']:.4f}", flush=True)
     return 0
 

@@ -560,12 +560,28 @@ def structured_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANG
     """
     triangles = check_plate_size(length, width, triangles)
     n, n_y = _structured_size(length, width, triangles)
-    h_x, h_y = length / n, width / n_y
     if equilateral:
-        column_x = equilateral_columns(length, width, n_y)
-        n = len(column_x) - 2
-    else:
-        column_x = (np.arange(n + 2) - 0.5) * h_x
+        return equilateral_mesh(length, width, n_y)
+    return _column_mesh(length, width, n_y, (np.arange(n + 2) - 0.5) * (length / n))
+
+
+def equilateral_mesh(length: float, width: float, rows: int) -> PlateMesh:
+    """The exactly equilateral structured mesh with `rows` (even, >= 2) rows of triangles
+    across W (equilateral_columns; structured_mesh(..., equilateral=True) picks rows from a
+    triangle count). Uniform refinement: rows times r gives every spacing divided by r."""
+    rows = check_integer("rows", rows, 2, 100_000, "an even number of triangle rows across W")
+    if rows % 2:
+        raise InputError(f"rows = {rows} is odd; it must be even (the centre y = 0 is a row of nodes)")
+    column_x = equilateral_columns(length, width, rows)
+    check_plate_size(length, width, 2 * (len(column_x) - 2) * rows)
+    return _column_mesh(length, width, rows, column_x)
+
+
+def _column_mesh(length: float, width: float, n_y: int, column_x: np.ndarray) -> PlateMesh:
+    """The structured mesh on columns at column_x (n + 2 of them, n odd, the two first and two
+    last clamped) with n_y rows (structured_mesh's docstring)."""
+    n = len(column_x) - 2
+    h_y = width / n_y
     columns = np.arange(n + 2)
     middle = (n + 1) // 2
     regular = (columns - middle) % 2 == 0

@@ -1,0 +1,178 @@
+"""Mesh studies of the DDG plate on the benchmark scenes (issue 16 item 2):
+`python -m validation.plate_gold --out data/plate_gold [--only NAME ...] [--levels K]`.
+
+Each of the ten scenes of fem_reference.gold (dL/L in {1/2, 1/4} x W/L in {1/20, 1/12, 1/6, 1/3,
+1/2}, L/b = 1181) is run with the plate on LEVELS exactly equilateral meshes
+(ddg.geometry.plate_mesh.equilateral_mesh) refined uniformly by 1.5: BASE_ROWS[W/L] rows of
+triangles across W, then 1.5 and 2.25 times as many (every spacing divided by 1.5 each time;
+the default structured mesh cannot refine uniformly, its column count must stay odd). Each run
+is the README's path (40 compression and 120 shear steps to dW_max, thresholds located, no
+branch tracing) into OUT/<scene>/R<rows>/ (path.csv, summary.json, centerline.csv); after each
+run the scene's study is rewritten with the same estimates as the FEM gold
+(fem_reference.convergence.study_estimates: Richardson with the observed order and a grid
+convergence index where asymptotic, else the finest value with its spread, flagged):
+OUT/<scene>/richardson.json and convergence.md, then OUT/index.json and OUT/README.md.
+Resumable run by run (a finished run on the same mesh is kept).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+from ddg.output.io import atomic_write_text
+
+#: Rows of triangles across W on the coarsest mesh (a multiple of 8: 1.5 and 2.25 times it stay even).
+BASE_ROWS = {1 / 20: 8, 1 / 12: 8, 1 / 6: 8, 1 / 3: 16, 1 / 2: 16}
+REFINEMENT = 1.5
+LEVELS = 3
+
+
+def rows_sequence(width_ratio: float, levels: int = LEVELS) -> list[int]:
+    base = next(v for w, v in BASE_ROWS.items() if abs(w - width_ratio) < 1e-9)
+    return [int(round(base * REFINEMENT**k)) for k in range(levels)]
+
+
+def _summary(path: Path) -> dict | None:
+    try:
+        summary = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return summary if isinstance(summary, dict) else None
+
+
+def _finished(folder: Path) -> bool:
+    summary = _summary(folder / "summary.json")
+    return bool(summary) and summary.get("status") in ("complete", "stopped")
+
+
+def run_scene(out: Path, name: str, compression: float, width: float, levels: int, quiet: bool) -> int:
+    import ddg
+    from ddg.geometry.plate_mesh import equilateral_mesh
+
+    status = 0
+    for rows in rows_sequence(width, levels):
+        target = out / name / f"R{rows}"
+        if _finished(target):
+            continue
+        strip = ddg.Strip.from_ratios(width, compression)
+        t0 = time.perf_counter()
+        result = ddg.simulate(strip, ddg.LoadingProtocol(compression), model="plate",
+                              mesh=equilateral_mesh(strip.length, strip.width, rows), out=target, branches=False)
+        if not quiet:
+            s = result.summary
+            print(f"{name} R{rows} ({s['mesh']['triangles']} triangles): {s['status']}, "
+                  f"{time.perf_counter() - t0:.0f} s, dW1/L {s['dW1_over_L']}, dW2/L {s['dW2_over_L']}", flush=True)
+        status = status or (0 if result.converged else 3)
+        write_scene_study(out / name, rows_sequence(width, levels))
+        write_index(out)
+    return status
+
+
+def write_scene_study(folder: Path, sequence: list[int]) -> dict | None:
+    """richardson.json and convergence.md of one scene from its finished runs of `sequence`."""
+    from ddg.output.io import StoredRun
+    from fem_reference.convergence import study_estimates
+
+    found = [(rows, folder / f"R{rows}") for rows in sequence if _finished(folder / f"R{rows}")]
+    if not found:
+        return None
+    runs = [StoredRun(str(path)) for _, path in found]
+    resolutions = [rows for rows, _ in found]
+    estimates = study_estimates(runs, resolutions)
+    scene = runs[-1].summary["scene"]
+    study = {"model": "plate", "mesh": "equilateral structured (ddg.geometry.plate_mesh.equilateral_mesh)",
+             "scene": {k: scene[k] for k in ("width_ratio", "compression_ratio", "slenderness")},
+             "meshes": [{"rows": rows, "folder": path.name, "status": run.summary["status"],
+                         "triangles": run.summary["mesh"]["triangles"], "wall_time_s": run.summary["wall_time_s"],
+                         "newton_iterations": run.summary["newton_iterations"],
+                         "dW1_over_L": run.summary["dW1_over_L"], "dW2_over_L": run.summary["dW2_over_L"],
+                         "H_mid_over_L_compressed": run.summary["H_mid_over_L_compressed"]}
+                        for (rows, path), run in zip(found, runs)],
+             "refinement_ratio": REFINEMENT, **estimates}
+    atomic_write_text(folder / "richardson.json", json.dumps(study, indent=2) + "\n")
+    lines = [f"# Plate mesh study: W/L = {scene['width_ratio']:.4g}, dL/L = {scene['compression_ratio']:g}", "",
+             "| rows across W | triangles | status | dW1/L | dW2/L | H_mid/L compressed | wall s | Newton its |",
+             "|---:|---:|---|---:|---:|---:|---:|---:|"]
+    for m in study["meshes"]:
+        lines.append(f"| {m['rows']} | {m['triangles']} | {m['status']} | {_fmt(m['dW1_over_L'])} | "
+                     f"{_fmt(m['dW2_over_L'])} | {_fmt(m['H_mid_over_L_compressed'], '{:.6f}')} | "
+                     f"{m['wall_time_s']:.0f} | {m['newton_iterations']} |")
+    lines.append("")
+    for key in ("dW1", "dW2", "H_mid_compressed"):
+        e = estimates.get(key)
+        if e:
+            lines.append(f"- {key}: {_fmt(e['value'], '{:.5f}')} +- {_fmt(e['error_bar'], '{:.5f}')} "
+                         f"(order {_fmt(e['order'], '{:.2f}')}; {e['basis']})")
+    atomic_write_text(folder / "convergence.md", "\n".join(lines) + "\n")
+    return study
+
+
+def _fmt(value, spec="{:.4f}"):
+    return "-" if not isinstance(value, (int, float)) or isinstance(value, bool) else spec.format(value)
+
+
+def write_index(out: Path) -> None:
+    from fem_reference.gold import scenes
+
+    index = {}
+    for name, _, _ in scenes():
+        study = _summary(out / name / "richardson.json")
+        if study is not None:
+            index[name] = {"meshes": [m["rows"] for m in study["meshes"]],
+                           "triangles": [m["triangles"] for m in study["meshes"]],
+                           "wall_time_s": sum(m["wall_time_s"] for m in study["meshes"]),
+                           **{k: study.get(k) for k in ("dW1", "dW2", "H_mid_compressed")}}
+    atomic_write_text(out / "index.json", json.dumps(index, indent=2) + "\n")
+    lines = ["# DDG plate mesh studies (validation/plate_gold.py)", "",
+             "Regenerate (run by run, finished runs kept): `.venv/bin/python -m validation.plate_gold --out "
+             "data/plate_gold`. Meshes: exactly equilateral, rows across W 8/12/18 (W/L <= 1/6) or 16/24/36; "
+             "error bars as the FEM gold's (data/fem_gold/README.md).", "",
+             "| scene | rows | triangles | dW1/L | +- | order | dW2/L | +- | order | wall s |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for name, e in index.items():
+        cells = []
+        for key in ("dW1", "dW2"):
+            est = e.get(key)
+            cells += ([_fmt(est["value"]), _fmt(est["error_bar"]),
+                       _fmt(est["order"], "{:.2f}") + ("" if est["asymptotic"] else " (not asymptotic)")]
+                      if est else ["-", "-", "-"])
+        lines.append(f"| {name} | {', '.join(map(str, e['meshes']))} | {', '.join(map(str, e['triangles']))} | "
+                     f"{' | '.join(cells)} | {e['wall_time_s']:.0f} |")
+    atomic_write_text(out / "README.md", "\n".join(lines) + "\n")
+
+
+def main(argv=None) -> int:
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+    from fem_reference.gold import scenes
+
+    parser = argparse.ArgumentParser(prog="python -m validation.plate_gold", description=__doc__.split("\n")[0])
+    parser.add_argument("--out", default="data/plate_gold")
+    parser.add_argument("--only", nargs="*", default=None)
+    parser.add_argument("--levels", type=int, default=LEVELS)
+    parser.add_argument("--quiet", action="store_true")
+    args = parser.parse_args(argv)
+    known = [name for name, _, _ in scenes()]
+    try:
+        unknown = [n for n in (args.only or []) if n not in known]
+        if unknown:
+            raise InputError(f"--only: unknown scene(s) {unknown}; choose from {', '.join(known)}")
+        if not 1 <= args.levels <= 4:
+            raise InputError(f"--levels = {args.levels} outside 1..4")
+        out = check_output_directory(args.out, "--out")
+    except InputError as exc:
+        print(f"error: {exc}")
+        return 2
+    status = 0
+    for name, compression, width in scenes():
+        if args.only and name not in args.only:
+            continue
+        status = run_scene(out, name, compression, width, args.levels, args.quiet) or status
+    write_index(out)
+    return status
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -28,13 +28,13 @@ SHEAR_RATIO = 0.22
 def meshes(width_ratio: float, low: int, high: int, step: int = 25,
            equilateral: bool = False) -> list[tuple[int, int, int, float]]:
     """(target triangles, n, n_y, aspect) of each distinct structured mesh with target in [low, high]."""
-    from ddg.geometry.plate_mesh import _structured_size  # noqa: PLC2701  (the mesh's own sizing rule)
+    from ddg.geometry.plate_mesh import structured_size
     from ddg.geometry.strip import Strip
 
     strip = Strip.from_ratios(width_ratio, COMPRESSION_RATIO)
     seen = {}
     for target in range(low, high + 1, step):
-        n, n_y = _structured_size(strip.length, strip.width, target)
+        n, n_y = structured_size(strip.length, strip.width, target)
         aspect = (strip.length / n) / (0.5 * math.sqrt(3.0) * strip.width / n_y)
         if equilateral:
             from ddg.geometry.plate_mesh import equilateral_columns

@@ -217,7 +217,7 @@ RUN_BYTES_PER_TRIANGLE = 10_000
 UNSTRUCTURED_BAND_FACTOR = 1.5
 
 
-def _structured_size(length: float, width: float, triangles: int) -> tuple[int, int]:
+def structured_size(length: float, width: float, triangles: int) -> tuple[int, int]:
     """(n, n_y) of the structured mesh with about `triangles` triangles in [0, L] (see structured_mesh)."""
     # 2 n n_y triangles in [0, L] with h_x = sqrt(3)/2 h_y
     h_y = math.sqrt(2.0 * length * width / (0.5 * math.sqrt(3.0) * triangles))
@@ -242,7 +242,7 @@ def plate_memory_estimate_bytes(length: float, width: float, triangles: int, *, 
     dominate (ddg.limits.check_memory refuses them).
     """
     if nodes is None or bandwidth_nodes is None:
-        n, n_y = _structured_size(length, width, triangles)
+        n, n_y = structured_size(length, width, triangles)
         nodes = (n + 2) * (n_y + 1.5) if nodes is None else nodes
         if bandwidth_nodes is None:
             bandwidth_nodes = 2 * (n_y + 2) * (UNSTRUCTURED_BAND_FACTOR if unstructured else 1.0)
@@ -559,7 +559,7 @@ def structured_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANG
     fits in memory (check_plate_size).
     """
     triangles = check_plate_size(length, width, triangles)
-    n, n_y = _structured_size(length, width, triangles)
+    n, n_y = structured_size(length, width, triangles)
     if equilateral:
         return equilateral_mesh(length, width, n_y)
     return _column_mesh(length, width, n_y, (np.arange(n + 2) - 0.5) * (length / n))

@@ -14,15 +14,13 @@ OUT/convergence.md (the table), plus each run's path.csv and summary.json under 
 """
 from __future__ import annotations
 
-import csv
-import io
 import math
 import os
 from pathlib import Path
 
 import numpy as np
 
-from ddg.output.io import atomic_write_text
+from ddg.output.io import atomic_write_text, write_table_csv
 
 
 def observed_order(f1, f2, f3, ratio):
@@ -316,17 +314,9 @@ def _away(dw, dw1, dw2, margin=0.02):
 
 def write_outputs(out: Path, rows, table, runs, resolutions, strip, protocol) -> None:
     out.mkdir(parents=True, exist_ok=True)
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
-    w.writeheader()
-    w.writerows(rows)
-    atomic_write_text(out / "convergence.csv", buf.getvalue())
+    write_table_csv(out / "convergence.csv", rows)
     keys = sorted({k for t in table for k in t}, key=lambda k: list(table[0]).index(k) if k in table[0] else 99)
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=keys, lineterminator="\n")
-    w.writeheader()
-    w.writerows(table)
-    atomic_write_text(out / "thresholds.csv", buf.getvalue())
+    write_table_csv(out / "thresholds.csv", table, keys)
 
     def f(v, fmt="{:.5f}"):
         return "-" if v is None or (isinstance(v, float) and not np.isfinite(v)) else fmt.format(v)

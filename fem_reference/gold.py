@@ -18,7 +18,7 @@ import json
 import time
 from pathlib import Path
 
-from ddg.output.io import atomic_write_text
+from ddg.output.io import atomic_write_text, read_json_object
 
 WIDTH_RATIOS = (1 / 20, 1 / 12, 1 / 6, 1 / 3, 1 / 2)
 COMPRESSION_RATIOS = (1 / 2, 1 / 4)
@@ -68,11 +68,7 @@ def scenes() -> list[tuple[str, float, float]]:
 
 def _read_summary(path: Path) -> dict | None:
     """summary.json of a scene folder, None if missing or unreadable (an unreadable one is rerun)."""
-    try:
-        summary = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-    return summary if isinstance(summary, dict) else None
+    return read_json_object(path)
 
 
 def check_gold_inputs(args) -> list[tuple[str, float, float, list[tuple[int, int]]]]:

@@ -21,7 +21,7 @@ import json
 import time
 from pathlib import Path
 
-from ddg.output.io import atomic_write_text
+from ddg.output.io import atomic_write_text, read_json_object
 
 #: Rows of triangles across W on the coarsest mesh (a multiple of 8: 1.5 and 2.25 times it stay even).
 BASE_ROWS = {1 / 20: 8, 1 / 12: 8, 1 / 6: 8, 1 / 3: 16, 1 / 2: 16}
@@ -34,16 +34,8 @@ def rows_sequence(width_ratio: float, levels: int = LEVELS) -> list[int]:
     return [int(round(base * REFINEMENT**k)) for k in range(levels)]
 
 
-def _summary(path: Path) -> dict | None:
-    try:
-        summary = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-    return summary if isinstance(summary, dict) else None
-
-
 def _finished(folder: Path) -> bool:
-    summary = _summary(folder / "summary.json")
+    summary = read_json_object(folder / "summary.json")
     return bool(summary) and summary.get("status") in ("complete", "stopped")
 
 
@@ -118,7 +110,7 @@ def write_index(out: Path) -> None:
 
     index = {}
     for name, _, _ in scenes():
-        study = _summary(out / name / "richardson.json")
+        study = read_json_object(out / name / "richardson.json")
         if study is not None:
             index[name] = {"meshes": [m["rows"] for m in study["meshes"]],
                            "triangles": [m["triangles"] for m in study["meshes"]],

@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import argparse
 import csv
-import io
 import math
 import time
 from pathlib import Path
 
-from ddg.output.io import atomic_write_text
+from ddg.output.io import atomic_write_text, write_table_csv
 
 COMPRESSION_RATIO = 0.5
 SHEAR_RATIO = 0.22
@@ -89,11 +88,7 @@ def main(argv=None) -> int:
 
 
 def _write(out: Path, name: str, rows: list[dict], width_ratio: float) -> None:
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write_text(out / f"{name}.csv", buf.getvalue())
+    write_table_csv(out / f"{name}.csv", rows)
     lines = [f"# Plate dW1/L over structured meshes, W/L = {width_ratio:.4g}, dL/L = {COMPRESSION_RATIO} "
              "(validation/plate_mesh_scan.py)", "",
              "aspect: column spacing over that of equilateral triangles (the rounding of n odd and n_y even).", "",

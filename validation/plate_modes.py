@@ -22,8 +22,6 @@ order of |1 - ratio| over the whole width).
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import math
 from pathlib import Path
 
@@ -32,7 +30,7 @@ import numpy as np
 from ddg.energies.hinge_bending import hinge_bending_energy
 from ddg.geometry.strip import Strip
 from ddg.models.plate import PlateModel
-from ddg.output.io import atomic_write_text
+from ddg.output.io import atomic_write_text, write_table_csv
 
 WIDTH_RATIOS = (1 / 6, 1 / 2)
 TRIANGLES = (500, 2000, 8000, 32000)
@@ -182,11 +180,7 @@ def study(widths=WIDTH_RATIOS, triangles=TRIANGLES, meshes=MESHES) -> tuple[list
 
 def write(out: Path, rows: list[dict], orders: list[dict]) -> None:
     out.mkdir(parents=True, exist_ok=True)
-    buf = io.StringIO()
-    writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    atomic_write_text(out / "modes.csv", buf.getvalue())
+    write_table_csv(out / "modes.csv", rows)
     lines = ["# DDG plate energies on exact smooth deformations (validation/plate_modes.py)", "",
              "Energy of the plate's terms over the continuum energy they stand for (bending: D, nu_b = -1/3; "
              "membrane: E b, nu = 1/3) in whole column periods mid-strip; `interior`: whole rows with |y| < ~W/4 only. "

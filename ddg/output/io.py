@@ -45,6 +45,25 @@ def atomic_write_text(path: Path, text: str) -> None:
             fh.write(text)
 
 
+def write_table_csv(path: Path, rows: list[dict], fieldnames: list[str] | None = None) -> None:
+    """Rows of dicts as a CSV table (header: fieldnames, default the first row's keys), written atomically."""
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=fieldnames or list(rows[0]), lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write_text(path, buf.getvalue())
+
+
+def read_json_object(path: Path) -> dict | None:
+    """A JSON file holding an object (summary.json, richardson.json), or None if it is missing,
+    unreadable or not an object."""
+    try:
+        value = json.loads(Path(path).read_text())
+    except (OSError, ValueError):
+        return None
+    return value if isinstance(value, dict) else None
+
+
 def _format(value):
     if isinstance(value, (bool, np.bool_)):
         return "1" if value else "0"

@@ -23,13 +23,14 @@ import time
 
 import numpy as np
 
+from ddg.protocol.after import ThresholdStep
 from ddg.protocol.driver import AfterStep
 
 from . import continuation
 from .continuation import GUESS_COMPRESSION_LIMIT, Branch, ContinuationFailure, Observation
 
-#: summary.json's message while the thresholds are located (ddg's threshold step says the same)
-LOCATING = "running: path complete, locating thresholds"
+#: summary.json's message while the thresholds are located: the DDG models' threshold step's
+LOCATING = ThresholdStep.checkpoint
 
 
 class ShellStepper:
@@ -185,5 +186,5 @@ def threshold_steps(shell: ShellStepper, summary: dict) -> list[AfterStep]:
         found, _ = continuation.locate_dw2(shell.stepper, shell.last_us, shell.first_s, shell.options.dw2_tolerance)
         summary["dW2_over_L"] = abs(found)
 
-    return [AfterStep("threshold location", timed(dw1), f"{LOCATING} (dW1, bisection on U)"),
-            AfterStep("threshold location", timed(dw2), f"{LOCATING} (dW2, bisection from US)")]
+    return [AfterStep(ThresholdStep.stage, timed(dw1), f"{LOCATING} (dW1, bisection on U)"),
+            AfterStep(ThresholdStep.stage, timed(dw2), f"{LOCATING} (dW2, bisection from US)")]

@@ -132,6 +132,7 @@ def follow(run: Run) -> PathOutcome:
         run.probe.step(stage, row, now - clock[0])
         clock[0] = now
 
+    kind = "compression"  # the stage of the rows being recorded
     try:
         state = stepper.rest()
         record("compression", state)
@@ -142,7 +143,7 @@ def follow(run: Run) -> PathOutcome:
         run.summary["H_mid_over_L_compressed"] = out.rows[-1]["H_mid_over_L"]
         if run.on_compressed is not None:
             run.on_compressed(out)
-        out.stage = "the shear stage"
+        out.stage, kind = "the shear stage", "shear"
         compression = run.loading.shear_compression
         for k, target in enumerate(run.loading.shear):
             state = stepper.advance(state, compression, target, "shear", k)
@@ -151,13 +152,14 @@ def follow(run: Run) -> PathOutcome:
     except KeyboardInterrupt as exc:
         out.interrupted = exc
     except Exception as exc:  # noqa: BLE001  (sorted below: the stepper's failure, or an error re-raised later)
-        if interrupt_behind(exc) is not None:
-            out.interrupted = interrupt_behind(exc)
+        interrupt = interrupt_behind(exc)
+        if interrupt is not None:
+            out.interrupted = interrupt
         elif isinstance(exc, stepper.failure):
             out.stopped = stepper.failure_message(exc)
             if getattr(exc, "reached", None) is not None:  # converged at the load, the step's goal not reached
                 try:
-                    record("shear" if out.stage == "the shear stage" else "compression", exc.reached)
+                    record(kind, exc.reached)
                 except KeyboardInterrupt as late:
                     out.interrupted = late
         else:
@@ -182,9 +184,8 @@ def execute(run: Run) -> SimulationResult:
         except KeyboardInterrupt as exc:
             out.interrupted = exc
         except Exception as exc:  # noqa: BLE001  (written as status "error", then re-raised)
-            if interrupt_behind(exc) is not None:
-                out.interrupted = interrupt_behind(exc)
-            else:
+            out.interrupted = interrupt_behind(exc)
+            if out.interrupted is None:
                 out.error = exc
     run.summary["wall_time_s"] = time.perf_counter() - t0
     run.stepper.summarise(run.summary)

@@ -27,7 +27,8 @@ from .solve.probe import SILENT, Probe
 __all__ = ["simulate", "run_ribbon", "simulate_dynamic", "make_model", "SimulationResult", "RibbonResult",
            "DynamicResult"]
 
-DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "ribbon": 101}  # ribbon: M not a multiple of 4, see RibbonModel
+#: ribbon: M not a multiple of 4, see RibbonModel
+DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "plate-midedge": 2000, "ribbon": 101}
 
 
 #: Stations along the centerline exported per recorded step (centerline.csv).
@@ -44,9 +45,15 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
     resolution = check_resolution(name, resolution)
     if mesh is None:
         return cls(strip, resolution)
-    if name != "plate":
-        raise InputError(f"a mesh is used by the plate model only, not {name!r}")
+    if name not in ("plate", "plate-midedge"):
+        raise InputError(f"a mesh is used by the plate models only, not {name!r}")
     from .geometry.plate_mesh import PlateMesh
+
+    if name == "plate-midedge":
+        if not isinstance(mesh, PlateMesh):
+            raise InputError(f"mesh = {mesh!r}: the mid-edge plate takes a PlateMesh from "
+                             "ddg.geometry.plate_mesh.ghost_clamp_mesh (no mesh files)")
+        return cls(strip, mesh=mesh)
 
     if not isinstance(mesh, (PlateMesh, str, os.PathLike)) or isinstance(mesh, bool):
         raise InputError(f"mesh = {mesh!r} must be a PlateMesh, a mesh file path or 'gmsh'")
@@ -69,11 +76,12 @@ def _frame_writer(model, directory: Path):
 
 
 def _model_class(name: str):
+    from .models.midedge_plate import MidedgePlateModel
     from .models.plate import PlateModel
     from .models.ribbon import RibbonModel
     from .models.rod import RodModel
 
-    models = {"rod": RodModel, "plate": PlateModel, "ribbon": RibbonModel}
+    models = {"rod": RodModel, "plate": PlateModel, "plate-midedge": MidedgePlateModel, "ribbon": RibbonModel}
     return models[check_model_name(name)]
 
 
@@ -237,7 +245,7 @@ def simulate(
         return simulate_dynamic(strip, protocol, resolution, dynamic_options, out=out)
     if dynamic_options is not None:
         raise InputError("dynamic_options apply to solver='dynamic' only")
-    branches = (model != "plate") if branches is None else bool(branches)
+    branches = (model not in ("plate", "plate-midedge")) if branches is None else bool(branches)
     instance = make_model(model, strip, resolution, mesh)
     if frames and out is None:
         raise InputError("frames=True needs an output directory (out)")

@@ -30,8 +30,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m ddg", description="DDG solvers for pre-buckled strips under shear.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sim = sub.add_parser("simulate", help="compress by dL, then shear by dW; write path.csv and summary.json")
-    sim.add_argument("--model", default="rod", choices=("rod", "plate", "ribbon"),
-                     help="rod (DAR, default), plate (DEP on a triangle mesh) or ribbon (Sadowsky, Eq. A.5)")
+    sim.add_argument("--model", default="rod", choices=("rod", "plate", "plate-midedge", "ribbon"),
+                     help="rod (DAR, default), plate (DEP on a triangle mesh), plate-midedge (mid-edge "
+                          "Kirchhoff plate with the material's Poisson ratio) or ribbon (Sadowsky, Eq. A.5)")
     sim.add_argument("--zeta", type=float, default=None,
                      help="ribbon: regularisation length zeta of Eq. (A.5) in metres (default 1e4 L)")
     sim.add_argument("--ribbon-init", choices=("direct", "rod"), default=None,

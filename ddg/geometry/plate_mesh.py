@@ -580,6 +580,41 @@ def equilateral_mesh(length: float, width: float, rows: int) -> PlateMesh:
 def _column_mesh(length: float, width: float, n_y: int, column_x: np.ndarray) -> PlateMesh:
     """The structured mesh on columns at column_x (n + 2 of them, n odd, the two first and two
     last clamped) with n_y rows (structured_mesh's docstring)."""
+    nodes, tris = _zipper(width, n_y, column_x)
+    return mesh_from_arrays(nodes, tris, length, width, clamp_depth=float(column_x[1]))
+
+
+def ghost_clamp_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANGLES, *,
+                     rows: int | None = None) -> PlateMesh:
+    """Structured mesh whose clamp lines are node columns, for the mid-edge plate.
+
+    Columns at x = k L / n, k = -1 .. n + 1 (n even, so the centre (L/2, 0) is a node), rows
+    n_y across W (even), h_x = L / n nearest to sqrt(3)/2 W / n_y; about `triangles` triangles
+    in [0, L] (structured_size's rows), or `rows` = n_y given. The nodes of the columns x <= 0
+    and x >= L are clamped (clamp_depth 0): the clamp columns x = 0 and x = L carry the clamped
+    edges, and the columns at -h_x and L + h_x make one layer of rigid ghost triangles, whose
+    normal is the clamp's (ddg.energies.midedge_bending). The free plate is exactly [0, L]."""
+    if rows is None:
+        triangles = check_plate_size(length, width, triangles)
+        _, rows = structured_size(length, width, triangles)
+    rows = check_integer("rows", rows, 2, 100_000, "an even number of triangle rows across W")
+    if rows % 2:
+        raise InputError(f"rows = {rows} is odd; it must be even (the centre y = 0 is a row of nodes)")
+    n = max(2, 2 * int(round(length / (math.sqrt(3.0) * width / rows))))
+    check_plate_size(length, width, 2 * n * rows)
+    h_x = length / n
+    nodes, tris = _zipper(width, rows, h_x * np.arange(-1, n + 2))
+    signed = _signed_areas(nodes, tris)
+    tris = np.where((signed < 0)[:, None], tris[:, [0, 2, 1]], tris)
+    order = np.lexsort((nodes[:, 1], nodes[:, 0]))
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    return PlateMesh(nodes[order], rank[tris], float(length), float(width), 0.0, 0.0)
+
+
+def _zipper(width: float, n_y: int, column_x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes (N, 2) and triangles (T, 3) of the zipper triangulation between columns at column_x
+    (an odd count, the middle one regular) with n_y rows (structured_mesh's docstring)."""
     n = len(column_x) - 2
     h_y = width / n_y
     columns = np.arange(n + 2)
@@ -608,4 +643,4 @@ def _column_mesh(length: float, width: float, n_y: int, column_x: np.ndarray) ->
     tri_up = np.stack([a_first[:, None] + kk - 1, b_first[:, None] + kk, a_first[:, None] + kk], axis=2)
     tri_down = np.stack([a_first[:, None] + kk, b_first[:, None] + kk, b_first[:, None] + kk + 1], axis=2)
     tris = np.concatenate([tri_first, tri_up.reshape(-1, 3), tri_down.reshape(-1, 3)])
-    return mesh_from_arrays(nodes, tris, length, width, clamp_depth=float(column_x[1]))
+    return nodes, tris

@@ -1,0 +1,94 @@
+"""Membrane energy of a triangle mesh: constant-strain triangles of an isotropic material.
+
+The membrane of the mid-edge plate (ddg.models.midedge_plate); the paper's plate keeps its
+edge springs (Eq. 11a, ddg.energies.stretch), whose continuum limit has Poisson ratio 1/3.
+Per triangle with deformed edge vectors e1 = p1 - p0, e2 = p2 - p0, metric a = [e_j . e_k] and
+reference metric abar, the Green strain (mixed) is eps = abar^-1 (a - abar) / 2 and
+
+  E_f = A (E b / (2 (1 - nu^2))) [nu tr(eps)^2 + (1 - nu) tr(eps^2)]   (plane stress, St Venant-Kirchhoff).
+
+With delta = (a11 - abar11, a12 - abar12, a22 - abar22) this is 1/2 delta^T C_f delta with a
+constant 3 x 3 C_f (`face_membrane_matrices`): tr(abar^-1 Delta) = w . delta with
+w = (B11, 2 B12, B22), B = abar^-1, and tr(B Delta B Delta) = delta^T P delta with
+P_ab = tr(B S_a B S_b) for the symmetric basis S. delta is quadratic in the positions
+(d a11 = 2 e1 . d e1, d a12 = e1 . d e2 + e2 . d e1, d a22 = 2 e2 . d e2), so
+grad = J^T C delta and hess = J^T C J + sum_k (C delta)_k Hess(a_k) with constant Hess(a_k).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..solve.band_scatter import add_symmetric_block
+
+_S = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]]])
+
+
+def face_membrane_matrices(nodes: np.ndarray, triangles: np.ndarray, young_modulus: float, thickness: float,
+                           poisson_ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """(C (T, 3, 3), abar (T, 3) = (abar11, abar12, abar22)) of the reference triangles (nodes (N, 2))."""
+    nu = poisson_ratio
+    p = nodes[triangles]
+    e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+    area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+    a11, a12, a22 = (np.einsum("ti,ti->t", e1, e1), np.einsum("ti,ti->t", e1, e2), np.einsum("ti,ti->t", e2, e2))
+    abar = np.stack([np.stack([a11, a12], axis=1), np.stack([a12, a22], axis=1)], axis=1)
+    B = np.linalg.inv(abar)
+    w = np.stack([B[:, 0, 0], 2.0 * B[:, 0, 1], B[:, 1, 1]], axis=1)
+    BS = np.einsum("tij,ajk->taik", B, _S)
+    P = np.einsum("taij,tbji->tab", BS, BS)
+    coefficient = area * young_modulus * thickness / (4.0 * (1.0 - nu * nu))
+    C = coefficient[:, None, None] * (nu * np.einsum("ta,tb->tab", w, w) + (1.0 - nu) * P)
+    return C, np.stack([a11, a12, a22], axis=1)
+
+
+@njit(cache=True)
+def add_membrane_terms(x, triangles, C, abar, vertex_dof, n, grad, band, want_gradient, want_hessian):
+    """Membrane energy sum_f 1/2 delta^T C_f delta; adds the gradient into grad (n,) and the
+    Hessian into the flattened lower band (ddg.solve.band_scatter). vertex_dof (N, 3)."""
+    energy = 0.0
+    dofs = np.empty(9, dtype=np.int64)
+    J = np.empty((3, 9))
+    block = np.empty((9, 9))
+    delta = np.empty(3)
+    for f in range(triangles.shape[0]):
+        p0, p1, p2 = triangles[f, 0], triangles[f, 1], triangles[f, 2]
+        e1 = x[p1] - x[p0]
+        e2 = x[p2] - x[p0]
+        delta[0] = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] - abar[f, 0]
+        delta[1] = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2] - abar[f, 1]
+        delta[2] = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2] - abar[f, 2]
+        Cd = C[f] @ delta
+        energy += 0.5 * (delta[0] * Cd[0] + delta[1] * Cd[1] + delta[2] * Cd[2])
+        if not want_gradient:
+            continue
+        for k in range(3):
+            dofs[k] = vertex_dof[p0, k]
+            dofs[3 + k] = vertex_dof[p1, k]
+            dofs[6 + k] = vertex_dof[p2, k]
+            # a11 = e1.e1, a12 = e1.e2, a22 = e2.e2 in (p0, p1, p2)
+            J[0, k], J[0, 3 + k], J[0, 6 + k] = -2.0 * e1[k], 2.0 * e1[k], 0.0
+            J[1, k], J[1, 3 + k], J[1, 6 + k] = -(e1[k] + e2[k]), e2[k], e1[k]
+            J[2, k], J[2, 3 + k], J[2, 6 + k] = -2.0 * e2[k], 0.0, 2.0 * e2[k]
+        for c in range(9):
+            grad[dofs[c]] += J[0, c] * Cd[0] + J[1, c] * Cd[1] + J[2, c] * Cd[2]
+        if not want_hessian:
+            continue
+        CJ = C[f] @ J
+        for r in range(9):
+            for c in range(9):
+                block[r, c] = J[0, r] * CJ[0, c] + J[1, r] * CJ[1, c] + J[2, r] * CJ[2, c]
+        # constant Hessians of a11 (on p0, p1), a22 (on p0, p2) and a12, times (C delta)_k
+        s11, s12, s22 = 2.0 * Cd[0], Cd[1], 2.0 * Cd[2]
+        for k in range(3):
+            block[k, k] += s11 + 2.0 * s12 + s22
+            block[3 + k, 3 + k] += s11
+            block[6 + k, 6 + k] += s22
+            block[k, 3 + k] -= s11 + s12
+            block[3 + k, k] -= s11 + s12
+            block[k, 6 + k] -= s22 + s12
+            block[6 + k, k] -= s22 + s12
+            block[3 + k, 6 + k] += s12
+            block[6 + k, 3 + k] += s12
+        add_symmetric_block(band, n, dofs, block)
+    return energy

@@ -1,0 +1,182 @@
+"""The mid-edge plate (`plate-midedge`): a discrete Kirchhoff plate with the material's Poisson ratio.
+
+The paper's plate (Eq. 11, ddg.models.plate) is kept as `plate`. This second plate model has
+the same kinematics for the nodes but its own energies, chosen so that the plate converges at
+second order with the mesh and its continuum limit is the Kirchhoff plate of the strip's
+material (Young's modulus E, Poisson ratio nu for both membrane and bending):
+
+- membrane: constant-strain triangles (ddg.energies.membrane), plane-stress St Venant-Kirchhoff;
+- bending: mid-edge normals (ddg.energies.midedge_bending): one angle DOF per edge, the
+  triangle's second fundamental form from its three mid-edge normals (Morley's element when
+  linearised), density D/2 [nu tr(M)^2 + (1 - nu) tr(M^2)] with D = E b^3 / (12 (1 - nu^2)).
+
+A narrow strip of this plate bends like the rod, EI2 = D (1 - nu^2) W = E W b^3 / 12, and twists
+with GJ = 2 D (1 - nu) W = E W b^3 / (6 (1 + nu)) (the paper's Eq. A.1), where the paper's
+plate, with its bending Poisson ratio -1/3, twists 4/3 stiffer (tested in
+tests/test_midedge_plate.py).
+
+DOFs: the nodes' positions (3 each) and the edges' angles (1 each), ordered together by x (of
+the node, of the edge's midpoint) so the Hessian is banded and the clamped DOFs come first and
+last. Clamps (ddg.geometry.plate_mesh.ghost_clamp_mesh): the node columns at x = 0 and x = L
+and one ghost column beyond each are clamped, with the angles of the edges between clamped
+nodes (theta = 0: the director of a clamped edge is the clamp's normal); the free plate is
+exactly [0, L].
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..energies.membrane import add_membrane_terms, face_membrane_matrices
+from ..energies.midedge_bending import ROLE_FIRST, ROLE_SECOND, add_midedge_terms, face_bending_matrices
+from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, ghost_clamp_mesh
+from ..geometry.strip import InputError, Strip
+from .base import Evaluation
+from .plate import PlateModel
+
+
+class MidedgePlateModel(PlateModel):
+    """The mid-edge plate of a Strip on a ghost-clamp structured mesh of ~`triangles` triangles
+    (or `rows` rows across W, or a given ghost_clamp_mesh)."""
+
+    name = "plate-midedge"
+
+    def __init__(self, strip: Strip, triangles: int = DEFAULT_TRIANGLES, *, rows: int | None = None,
+                 mesh: PlateMesh | None = None):
+        self.strip = strip
+        if mesh is None:
+            mesh = ghost_clamp_mesh(strip.length, strip.width, triangles, rows=rows)
+        elif mesh.clamp_depth != 0.0:
+            raise InputError("the mid-edge plate needs a mesh whose clamp lines are node columns "
+                             "(ddg.geometry.plate_mesh.ghost_clamp_mesh)")
+        self.mesh = mesh
+        nodes, tris, edges = mesh.nodes, mesh.triangles, mesh.edges
+        n_nodes, n_edges = len(nodes), len(edges)
+        clamped = mesh.clamped_left | mesh.clamped_right
+        edge_clamped = clamped[edges[:, 0]] & clamped[edges[:, 1]]
+        rigid = clamped[tris].all(axis=1)
+
+        # DOF numbering: nodes and edges ordered together by x (clamped ones first and last)
+        key = np.r_[nodes[:, 0], 0.5 * (nodes[edges[:, 0], 0] + nodes[edges[:, 1], 0])]
+        kind = np.r_[np.zeros(n_nodes, dtype=np.int64), np.ones(n_edges, dtype=np.int64)]
+        index = np.r_[np.arange(n_nodes), np.arange(n_edges)]
+        order = np.lexsort((index, kind, key))
+        width = np.where(kind[order] == 0, 3, 1)
+        start = np.r_[0, np.cumsum(width)[:-1]]
+        self.n_dof = int(width.sum())
+        node_start = np.empty(n_nodes, dtype=np.int64)
+        edge_start = np.empty(n_edges, dtype=np.int64)
+        is_node = kind[order] == 0
+        node_start[index[order][is_node]] = start[is_node]
+        edge_start[index[order][~is_node]] = start[~is_node]
+        self.node_dofs = node_start[:, None] + np.arange(3)[None, :]
+        self.edge_dofs = edge_start
+        constrained_entity = np.r_[clamped, edge_clamped][order]
+        free_entities = np.flatnonzero(~constrained_entity)
+        first, last = free_entities[0], free_entities[-1]
+        if constrained_entity[first:last + 1].any():
+            raise InputError("mesh clamps are not at its ends (the mid-edge plate orders DOFs by x)")
+        self.free = slice(int(start[first]), int(start[last] + width[last]))
+        self.constrained = np.r_[np.arange(self.free.start), np.arange(self.free.stop, self.n_dof)]
+        self.left_nodes, self.right_nodes = np.flatnonzero(mesh.clamped_left), np.flatnonzero(mesh.clamped_right)
+
+        # connectivity: each triangle's edges (opposite vertex i), its role on them, the hinges
+        # with the first triangle a (a rigid ghost triangle where there is one)
+        key_edges = edges[:, 0].astype(np.int64) * n_nodes + edges[:, 1]
+        face_edges = np.empty_like(tris)
+        for i in range(3):
+            a, b = tris[:, (i + 1) % 3], tris[:, (i + 2) % 3]
+            key_faces = np.minimum(a, b).astype(np.int64) * n_nodes + np.maximum(a, b)
+            face_edges[:, i] = np.searchsorted(key_edges, key_faces)
+        hinges = mesh.hinges.copy()
+        pair = mesh.hinge_triangles.copy()
+        swap = rigid[pair[:, 1]] & ~rigid[pair[:, 0]]
+        hinges[swap] = hinges[swap][:, [1, 0, 3, 2]]
+        pair[swap] = pair[swap][:, ::-1]
+        hinge_of_edge = np.full(n_edges, -1, dtype=np.int64)
+        hinge_of_edge[mesh.hinge_edges] = np.arange(len(hinges))
+        second_of_edge = np.full(n_edges, -1, dtype=np.int64)
+        second_of_edge[mesh.hinge_edges] = pair[:, 1]
+        roles = np.where(second_of_edge[face_edges] == np.arange(len(tris))[:, None], ROLE_SECOND, ROLE_FIRST)
+
+        E, b, nu = strip.young_modulus, strip.thickness, strip.poisson_ratio
+        self._membrane, self._abar = face_membrane_matrices(nodes, tris, E, b, nu)
+        self._bending = face_bending_matrices(nodes, tris, E, b, nu)
+        self._triangles = np.ascontiguousarray(tris, dtype=np.int64)
+        self._face_edges = np.ascontiguousarray(face_edges, dtype=np.int64)
+        self._roles = np.ascontiguousarray(roles, dtype=np.int64)
+        self._hinges = np.ascontiguousarray(hinges, dtype=np.int64)
+        self._hinge_of_edge = hinge_of_edge
+        self._node_dofs = np.ascontiguousarray(self.node_dofs, dtype=np.int64)
+        self._edge_dofs = np.ascontiguousarray(self.edge_dofs, dtype=np.int64)
+
+        # bandwidth: the widest stencil (a triangle, the far vertices of its hinges, its edges)
+        far = np.where(roles == ROLE_SECOND, hinges[np.maximum(hinge_of_edge[face_edges], 0), 2], tris)
+        stencil = np.concatenate([self.node_dofs[tris].reshape(len(tris), -1),
+                                  self.node_dofs[far].reshape(len(tris), -1), self.edge_dofs[face_edges]], axis=1)
+        self.bandwidth = int((stencil.max(axis=1) - stencil.min(axis=1)).max())
+
+        self.rest_edge_lengths = np.linalg.norm(nodes[edges[:, 1]] - nodes[edges[:, 0]], axis=1)
+        self.stretch_stiffness = E * b * mesh.edge_triangle_areas / self.rest_edge_lengths**2 / (1.0 - nu * nu)
+        self._centre = mesh.interpolation_matrix(np.array([[0.5 * strip.length, 0.0]]))
+        quarter = np.array([[0.25 * strip.length, 0.0], [0.75 * strip.length, 0.0]])
+        self._quarters = mesh.interpolation_matrix(quarter)
+
+    # ------------------------------------------------------------------ energy
+    def evaluate(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
+        """Energy (membrane + mid-edge bending), gradient and banded Hessian at q."""
+        x = np.ascontiguousarray(q[self._node_dofs])
+        theta = np.ascontiguousarray(q[self._edge_dofs])
+        hessian = hessian and gradient
+        n = self.n_dof
+        grad, band = self._accumulators(gradient, hessian)
+        stretching = add_membrane_terms(x, self._triangles, self._membrane, self._abar, self._node_dofs, n,
+                                        grad, band, gradient, hessian)
+        bending = add_midedge_terms(x, theta, self._triangles, self._face_edges, self._roles, self._hinge_of_edge,
+                                    self._hinges, self._bending, self._node_dofs, self._edge_dofs, n,
+                                    grad, band, gradient, hessian)
+        parts = {"stretching": float(stretching), "bending": float(bending)}
+        return self._evaluation(parts, grad, band, gradient, hessian)
+
+    # ------------------------------------------------------------------ metrics and scales
+    def _edge_areas(self) -> np.ndarray:
+        return self.mesh.edge_triangle_areas / 3.0
+
+    def eigenvalue_metric(self) -> tuple[np.ndarray, float]:
+        """Lumped metric as the paper's plate's (node area / W per coordinate), and for an edge
+        angle its area share / W times h^2 / 12 (the rod's h W^2 / 12 for its twist angle)."""
+        metric = np.empty(self.n_dof)
+        metric[self.node_dofs] = (self.mesh.node_areas / self.strip.width)[:, None]
+        h = self._typical_spacing()
+        metric[self.edge_dofs] = self._edge_areas() / self.strip.width * h * h / 12.0
+        return metric[self.free], self.strip.bending_stiffness / self.strip.length**4
+
+    def residual_scale(self) -> np.ndarray:
+        """Per-node force unit as the paper's plate's; an edge angle's moment unit is the force
+        unit of its area share times the spacing h (an angle error delta weighs as a
+        displacement delta h)."""
+        s = self.strip
+        h = self._typical_spacing()
+        unit = s.bending_stiffness / s.length**2 / (s.width * h)
+        scale = np.empty(self.n_dof)
+        scale[self.node_dofs] = (unit * self.mesh.node_areas)[:, None]
+        scale[self.edge_dofs] = unit * self._edge_areas() * h
+        return scale
+
+    def length_scale(self) -> np.ndarray:
+        """L for positions, 1 rad for edge angles."""
+        scale = np.full(self.n_dof, self.strip.length)
+        scale[self.edge_dofs] = 1.0
+        return scale
+
+    def residual_floor(self) -> float:
+        floor = 6.0 * np.finfo(float).eps * float(self.stretch_stiffness.max()) * self.strip.length
+        return 10.0 * floor / float(self.residual_scale()[self.node_dofs[~(self.mesh.clamped_left
+                                                                            | self.mesh.clamped_right)]].min())
+
+
+def twisting_stiffness(strip: Strip) -> float:
+    """GJ of a narrow strip of the mid-edge plate: 2 D (1 - nu) W = E W b^3 / (6 (1 + nu))."""
+    nu = strip.poisson_ratio
+    D = strip.young_modulus * strip.thickness**3 / (12.0 * (1.0 - nu * nu))
+    return 2.0 * D * (1.0 - nu) * strip.width
+

@@ -125,23 +125,6 @@ def _add_bilinear(slots, w, scale, H):
         H[c + 1, r + 2] -= scale * w[0]
 
 
-@njit(cache=True)
-def _cross_pair(Jp, Jq, r, scale, H):
-    """H += scale * (Jp^T (-[r]x) Jq + its transpose): the second variation (dp x dq) . r."""
-    # (-[r]x) Jq
-    t = np.empty((3, 12))
-    for k in range(12):
-        q0, q1, q2 = Jq[0, k], Jq[1, k], Jq[2, k]
-        t[0, k] = r[2] * q1 - r[1] * q2
-        t[1, k] = r[0] * q2 - r[2] * q0
-        t[2, k] = r[1] * q0 - r[0] * q1
-    for i in range(12):
-        for k in range(12):
-            v = scale * (Jp[0, i] * t[0, k] + Jp[1, i] * t[1, k] + Jp[2, i] * t[2, k])
-            H[i, k] += v
-            H[k, i] += v
-
-
 _SLOTS_A = np.array([0, 1, 2], dtype=np.int64)  # a = (v0, v1, o_a)
 _SLOTS_B = np.array([1, 0, 3], dtype=np.int64)  # b = (v1, v0, o_b)
 
@@ -150,71 +133,115 @@ _SLOTS_B = np.array([1, 0, 3], dtype=np.int64)  # b = (v1, v0, o_b)
 def hinge_angle(p, want_gradient, want_hessian, grad, hess):
     """Signed bending angle psi of the hinge p (4, 3) = (v0, v1, o_a, o_b), into grad (12,) and
     hess (12, 12) when asked (module docstring); returns psi."""
-    slots_a, slots_b = _SLOTS_A, _SLOTS_B
-    ua, ub, e, w = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
-    for k in range(3):
-        e[k] = p[1, k] - p[0, k]
-        w[k] = p[2, k] - p[0, k]
-    _cross(e, w, ua)
-    a1 = np.empty(3)
-    for k in range(3):
-        a1[k] = p[0, k] - p[1, k]
-        w[k] = p[3, k] - p[1, k]
-    _cross(a1, w, ub)
-    length = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
+    Ja, Jb, HX, HT, t3, dX, dT, dl, dY = (np.empty((3, 12)), np.empty((3, 12)), np.empty((12, 12)),
+                                          np.empty((12, 12)), np.empty((3, 12)), np.empty(12), np.empty(12),
+                                          np.empty(12), np.empty(12))
+    return hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT, t3, dX, dT, dl, dY)
+
+
+@njit(cache=True)
+def _add_transposed_products(J1, J2, t3, r, scale, H):
+    """H += scale (J1^T (-[r]x) J2 + its transpose): the second variation (dp x dq) . r; t3 (3, 12) scratch."""
+    for k in range(12):
+        q0, q1, q2 = J2[0, k], J2[1, k], J2[2, k]
+        t3[0, k] = r[2] * q1 - r[1] * q2
+        t3[1, k] = r[0] * q2 - r[2] * q0
+        t3[2, k] = r[1] * q0 - r[0] * q1
+    for i in range(12):
+        a0, a1, a2 = J1[0, i], J1[1, i], J1[2, i]
+        if a0 == 0.0 and a1 == 0.0 and a2 == 0.0:
+            continue
+        for k in range(12):
+            v = scale * (a0 * t3[0, k] + a1 * t3[1, k] + a2 * t3[2, k])
+            H[i, k] += v
+            H[k, i] += v
+
+
+@njit(cache=True)
+def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT, t3, dX, dT, dl, dY):
+    """hinge_angle with the caller's scratch arrays (allocated once per assembly, not per hinge)."""
+    e0, e1, e2 = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
+    w0, w1, w2 = p[2, 0] - p[0, 0], p[2, 1] - p[0, 1], p[2, 2] - p[0, 2]
+    ua = np.array([e1 * w2 - e2 * w1, e2 * w0 - e0 * w2, e0 * w1 - e1 * w0])
+    f0, f1, f2 = -e0, -e1, -e2
+    w0, w1, w2 = p[3, 0] - p[1, 0], p[3, 1] - p[1, 1], p[3, 2] - p[1, 2]
+    ub = np.array([f1 * w2 - f2 * w1, f2 * w0 - f0 * w2, f0 * w1 - f1 * w0])
+    e = np.array([e0, e1, e2])
+    length = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
     X = ua[0] * ub[0] + ua[1] * ub[1] + ua[2] * ub[2]
     ubxua = np.empty(3)
     _cross(ub, ua, ubxua)
-    T = ubxua[0] * e[0] + ubxua[1] * e[1] + ubxua[2] * e[2]
+    T = ubxua[0] * e0 + ubxua[1] * e1 + ubxua[2] * e2
     Y = T / length
     psi = math.atan2(Y, X)
     if not want_gradient:
         return psi
-    Ja, Jb = np.empty((3, 12)), np.empty((3, 12))
-    _normal_jacobian(p, slots_a, Ja)
-    _normal_jacobian(p, slots_b, Jb)
-    # e = v1 - v0: Je = [-I, I, 0, 0]
+    _normal_jacobian(p, _SLOTS_A, Ja)
+    _normal_jacobian(p, _SLOTS_B, Jb)
+    uaxe, exub = np.empty(3), np.empty(3)
+    _cross(ua, e, uaxe)
+    _cross(e, ub, exub)
+    # Je = [-I, I, 0, 0] (e = v1 - v0) is applied by hand below
+    for i in range(12):
+        dX[i] = Ja[0, i] * ub[0] + Ja[1, i] * ub[1] + Ja[2, i] * ub[2] \
+            + Jb[0, i] * ua[0] + Jb[1, i] * ua[1] + Jb[2, i] * ua[2]
+        dT[i] = Jb[0, i] * uaxe[0] + Jb[1, i] * uaxe[1] + Jb[2, i] * uaxe[2] \
+            + Ja[0, i] * exub[0] + Ja[1, i] * exub[1] + Ja[2, i] * exub[2]
+        dl[i] = 0.0
+    for k in range(3):
+        dT[k] -= ubxua[k]
+        dT[3 + k] += ubxua[k]
+        dl[k] = -e[k] / length
+        dl[3 + k] = e[k] / length
+    R2 = X * X + Y * Y
+    for i in range(12):
+        dY[i] = dT[i] / length - T * dl[i] / (length * length)
+        grad[i] = (X * dY[i] - Y * dX[i]) / R2
+    if not want_hessian:
+        return psi
+    HX[:, :] = 0.0
+    _add_bilinear(_SLOTS_A, ub, 1.0, HX)
+    _add_bilinear(_SLOTS_B, ua, 1.0, HX)
+    for i in range(12):
+        for k in range(12):
+            v = Ja[0, i] * Jb[0, k] + Ja[1, i] * Jb[1, k] + Ja[2, i] * Jb[2, k]
+            HX[i, k] += v
+            HX[k, i] += v
+    HT[:, :] = 0.0
+    _add_bilinear(_SLOTS_B, uaxe, 1.0, HT)
+    _add_bilinear(_SLOTS_A, exub, 1.0, HT)
+    _add_transposed_products(Jb, Ja, t3, e, 1.0, HT)
+    # the pairs with de: (du_a x de) . u_b and (de x du_b) . u_a, de = dv1 - dv0
+    for k in range(3):
+        for j in range(12):
+            t3[k, j] = 0.0
+        t3[k, k] = -1.0
+        t3[k, 3 + k] = 1.0
+    _add_transposed_products(Ja, t3.copy(), t3, ub, 1.0, HT)
     Je = np.zeros((3, 12))
     for k in range(3):
         Je[k, k] = -1.0
         Je[k, 3 + k] = 1.0
-    ehat = e / length
-    uaxe, exub = np.empty(3), np.empty(3)
-    _cross(ua, e, uaxe)
-    _cross(e, ub, exub)
-    dX = Ja.T @ ub + Jb.T @ ua
-    dT = Jb.T @ uaxe + Ja.T @ exub + Je.T @ ubxua
-    dl = Je.T @ ehat
-    dY = dT / length - T * dl / length**2
-    R2 = X * X + Y * Y
+    _add_transposed_products(Je, Jb, t3, ua, 1.0, HT)
+    inv_l = 1.0 / length
     for i in range(12):
-        grad[i] = (X * dY[i] - Y * dX[i]) / R2
-    if not want_hessian:
-        return psi
-    # X = ua . ub
-    HX = np.zeros((12, 12))
-    _add_bilinear(slots_a, ub, 1.0, HX)
-    _add_bilinear(slots_b, ua, 1.0, HX)
-    JaJb = Ja.T @ Jb
-    HX += JaJb + JaJb.T
-    # T = (ub x ua) . e: second variations of each factor, then the pairs
-    HT = np.zeros((12, 12))
-    _add_bilinear(slots_b, uaxe, 1.0, HT)
-    _add_bilinear(slots_a, exub, 1.0, HT)
-    _cross_pair(Jb, Ja, e, 1.0, HT)
-    _cross_pair(Ja, Je, ub, 1.0, HT)
-    _cross_pair(Je, Jb, ua, 1.0, HT)
-    # l = |e|
-    proj = np.eye(3) - np.outer(ehat, ehat)
-    Hl = Je.T @ proj @ Je / length
-    HY = (HT / length - (np.outer(dT, dl) + np.outer(dl, dT)) / length**2 - T * Hl / length**2
-          + 2.0 * T * np.outer(dl, dl) / length**3)
-    g = X * dY - Y * dX
-    H = (X * HY - Y * HX + np.outer(dY, dX) - np.outer(dX, dY)) / R2 \
-        - np.outer(g, 2.0 * X * dX + 2.0 * Y * dY) / (R2 * R2)
-    for i in range(12):
-        for k in range(12):
-            hess[i, k] = 0.5 * (H[i, k] + H[k, i])
+        for k in range(i, 12):
+            # Hessian of l = |e|: Je^T (I - e e^T / l^2) Je / l, nonzero on the (v0, v1) blocks
+            hl = 0.0
+            if i < 6 and k < 6:
+                a, b = i % 3, k % 3
+                sign = (1.0 if (i < 3) == (k < 3) else -1.0)
+                hl = sign * ((1.0 if a == b else 0.0) - e[a] * e[b] * inv_l * inv_l) * inv_l
+            hy = (HT[i, k] * inv_l - (dT[i] * dl[k] + dl[i] * dT[k]) * inv_l * inv_l - T * hl * inv_l * inv_l
+                  + 2.0 * T * dl[i] * dl[k] * inv_l**3)
+            gi = X * dY[i] - Y * dX[i]
+            gk = X * dY[k] - Y * dX[k]
+            h_ik = (X * hy - Y * HX[i, k] + dY[i] * dX[k] - dX[i] * dY[k]) / R2 \
+                - gi * (2.0 * X * dX[k] + 2.0 * Y * dY[k]) / (R2 * R2)
+            h_ki = (X * hy - Y * HX[i, k] + dY[k] * dX[i] - dX[k] * dY[i]) / R2 \
+                - gk * (2.0 * X * dX[i] + 2.0 * Y * dY[i]) / (R2 * R2)
+            hess[i, k] = 0.5 * (h_ik + h_ki)
+            hess[k, i] = hess[i, k]
     return psi
 
 
@@ -242,6 +269,11 @@ def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge
     phi = np.empty(3)
     psis_hess = np.empty((3, 12, 12))
     psis_slots = np.empty((3, 4), dtype=np.int64)
+    Ja, Jb, HX, HT, t3, dX, dT, dl, dY = (np.empty((3, 12)), np.empty((3, 12)), np.empty((12, 12)),
+                                          np.empty((12, 12)), np.empty((3, 12)), np.empty(12), np.empty(12),
+                                          np.empty(12), np.empty(12))
+    kphi = np.empty(3)
+    KJ = np.empty((3, 21))
     for f in range(triangles.shape[0]):
         m = 0
         for a in range(3):
@@ -278,7 +310,7 @@ def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge
                         dofs[m + k] = vertex_dof[v, k]
                     m += 3
                 slot_of[s] = found
-            psi = hinge_angle(pts, want_gradient, want_hessian, gloc, hloc)
+            psi = hinge_angle_into(pts, want_gradient, want_hessian, gloc, hloc, Ja, Jb, HX, HT, t3, dX, dT, dl, dY)
             phi[i] = -(theta[e] + psi)
             if want_gradient:
                 for s in range(4):
@@ -288,8 +320,8 @@ def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge
                 psis_hess[i] = hloc
                 for s in range(4):
                     psis_slots[i, s] = slot_of[s]
-        Kf = K[f]
-        kphi = Kf @ phi
+        for i in range(3):
+            kphi[i] = K[f, i, 0] * phi[0] + K[f, i, 1] * phi[1] + K[f, i, 2] * phi[2]
         energy += 0.5 * (phi[0] * kphi[0] + phi[1] * kphi[1] + phi[2] * kphi[2])
         if not want_gradient:
             continue
@@ -298,7 +330,9 @@ def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge
             grad[dofs[c]] += gstencil[c]
         if not want_hessian:
             continue
-        KJ = Kf @ J
+        for i in range(3):
+            for c in range(m):
+                KJ[i, c] = K[f, i, 0] * J[0, c] + K[f, i, 1] * J[1, c] + K[f, i, 2] * J[2, c]
         for r in range(m):
             for c in range(m):
                 block[r, c] = J[0, r] * KJ[0, c] + J[1, r] * KJ[1, c] + J[2, r] * KJ[2, c]

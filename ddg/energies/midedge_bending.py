@@ -107,22 +107,13 @@ def _normal_jacobian(p, slots, J):
 def _add_bilinear(slots, w, scale, H):
     """H += scale * Hessian of w . u in the 12 hinge coordinates (u of the triangle on `slots`):
     blocks (i, i+1) = -[w]x, (i+1, i) = +[w]x."""
+    skew = np.array([[0.0, w[2], -w[1]], [-w[2], 0.0, w[0]], [w[1], -w[0], 0.0]])  # -[w]x
     for i in range(3):
         r, c = 3 * slots[i], 3 * slots[(i + 1) % 3]
-        # -[w]x
-        H[r + 0, c + 1] += scale * w[2]
-        H[r + 0, c + 2] -= scale * w[1]
-        H[r + 1, c + 0] -= scale * w[2]
-        H[r + 1, c + 2] += scale * w[0]
-        H[r + 2, c + 0] += scale * w[1]
-        H[r + 2, c + 1] -= scale * w[0]
-        # its transpose into (i+1, i)
-        H[c + 1, r + 0] += scale * w[2]
-        H[c + 2, r + 0] -= scale * w[1]
-        H[c + 0, r + 1] -= scale * w[2]
-        H[c + 2, r + 1] += scale * w[0]
-        H[c + 0, r + 2] += scale * w[1]
-        H[c + 1, r + 2] -= scale * w[0]
+        for a in range(3):
+            for b in range(3):
+                H[r + a, c + b] += scale * skew[a, b]
+                H[c + b, r + a] += scale * skew[a, b]
 
 
 _SLOTS_A = np.array([0, 1, 2], dtype=np.int64)  # a = (v0, v1, o_a)

@@ -118,6 +118,7 @@ def _add_bilinear(slots, w, scale, H):
 
 _SLOTS_A = np.array([0, 1, 2], dtype=np.int64)  # a = (v0, v1, o_a)
 _SLOTS_B = np.array([1, 0, 3], dtype=np.int64)  # b = (v1, v0, o_b)
+_JE = np.hstack([-np.eye(3), np.eye(3), np.zeros((3, 6))])  # de/dq of the hinge edge e = v1 - v0
 
 
 @njit(cache=True)
@@ -203,17 +204,8 @@ def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT,
     _add_bilinear(_SLOTS_A, exub, 1.0, HT)
     _add_transposed_products(Jb, Ja, t3, e, 1.0, HT)
     # the pairs with de: (du_a x de) . u_b and (de x du_b) . u_a, de = dv1 - dv0
-    for k in range(3):
-        for j in range(12):
-            t3[k, j] = 0.0
-        t3[k, k] = -1.0
-        t3[k, 3 + k] = 1.0
-    _add_transposed_products(Ja, t3.copy(), t3, ub, 1.0, HT)
-    Je = np.zeros((3, 12))
-    for k in range(3):
-        Je[k, k] = -1.0
-        Je[k, 3 + k] = 1.0
-    _add_transposed_products(Je, Jb, t3, ua, 1.0, HT)
+    _add_transposed_products(Ja, _JE, t3, ub, 1.0, HT)
+    _add_transposed_products(_JE, Jb, t3, ua, 1.0, HT)
     inv_l = 1.0 / length
     for i in range(12):
         for k in range(i, 12):
@@ -340,12 +332,3 @@ def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge
         add_symmetric_block(band, n, dofs[:m], block[:m, :m])
     return energy
 
-
-def midedge_bending_energy(x, theta, triangles, face_edges, face_roles, hinge_of_edge, hinges, K):
-    """The bending energy alone (no derivatives), for tests and analysis."""
-    n = 0
-    vertex_dof = np.zeros((len(x), 3), dtype=np.int64)
-    edge_dof = np.zeros(len(theta), dtype=np.int64)
-    return add_midedge_terms(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(theta, dtype=float),
-                             triangles, face_edges, face_roles, hinge_of_edge, hinges, K, vertex_dof, edge_dof,
-                             n, np.empty(0), np.empty(0), False, False)

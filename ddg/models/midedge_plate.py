@@ -173,10 +173,3 @@ class MidedgePlateModel(PlateModel):
         return 10.0 * floor / float(self.residual_scale()[self.node_dofs[~(self.mesh.clamped_left
                                                                             | self.mesh.clamped_right)]].min())
 
-
-def twisting_stiffness(strip: Strip) -> float:
-    """GJ of a narrow strip of the mid-edge plate: 2 D (1 - nu) W = E W b^3 / (6 (1 + nu))."""
-    nu = strip.poisson_ratio
-    D = strip.young_modulus * strip.thickness**3 / (12.0 * (1.0 - nu * nu))
-    return 2.0 * D * (1.0 - nu) * strip.width
-

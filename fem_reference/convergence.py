@@ -280,7 +280,7 @@ def summarise(runs, resolutions):
         steps = s["recorded_steps"] - 1
         table.append({
             "resolution": resolutions[i],
-            "triangles": s["mesh"]["triangles"],
+            "triangles": (s.get("mesh") or {}).get("triangles"),
             "n_dof": s["n_dof"],
             "H_compressed": s["H_mid_over_L_compressed"],
             "H_compressed_error": abs(s["H_mid_over_L_compressed"] - float(Hc_ext[0])),

@@ -19,13 +19,15 @@ from ddg.analysis.analytic import clamped_elastica_midpoint_height
 from ddg.geometry.strip import shear_limit
 
 from . import claims as C
+from .estimates import Study, load_study, single_run_study, study_from_runs
 from .reference import FEM_FINE, PAPER_DROPS_QUARTER, GoldCurve, load_dep_material, load_gold, paper_value
-from .studies import COMPRESSIONS, CROSS_MODEL_PLATE, SNAPSHOT_SCENES, SPEED_SCENE, Profile
+from .studies import COMPRESSIONS, SNAPSHOT_SCENES, SPEED_SCENE, Profile
 from .verdicts import (PAPER_DISAGREEMENT, ClaimsVerdict, MaterialCheck, MeshTrend, PaperReading, paper_disagreements,
                        unusual_outcomes)
 
 MODELS = ("rod", "plate", "ribbon")
-CLAIM_COLUMNS = ["claim", "statement", "bound", "measured", "holds", "reason"]
+CLAIM_COLUMNS = ["claim", "statement", "bound", "measured", "holds", "reason", "difference", "combined_error_bar",
+                 "in_error_bars", "needs"]
 THRESHOLD_COLUMNS = ["model", "compression_ratio", "width_ratio", "dW1_over_L", "paper_dW1", "dW1_rel_diff_vs_paper",
                      "dW2_over_L", "paper_dW2", "dW2_rel_diff_vs_paper", "dW2_S_stable_over_L",
                      "dW1_drop_vs_W_1_20_percent", "paper_drop_percent", "dW_max_over_L"]
@@ -518,30 +520,35 @@ def material_check(results, golds) -> MaterialCheck | None:
     """Is the plate/FEM gap at SPEED_SCENE the plate's material (the DEP's nu = 1/3 membrane and
     nu_b = -1/3 bending, against the shell's nu = 0)? The material's effect (the FEM shell run with
     the DEP's material, data/fem_dep, against the nu = 0 shell on the same mesh, data/fem_fine) is
-    set against the gap (the plate against the nu = 0 gold shell) and the plate against the shell
-    with its own material; with the plate's dW1 against its mesh where the profile runs several."""
+    set against the gap (the plate's converged values, data/plate_gold, against the FEM gold's,
+    largest difference) and the plate against the shell with its own material; with the plate's
+    dW1 on each mesh of its study."""
     iso_dir = FEM_FINE / "dL0.5_W0.1667_N90"
-    plate = find_run(results, "plate", *SPEED_SCENE, CROSS_MODEL_PLATE)
+    plate, fem = load_study("plate", *SPEED_SCENE), load_study("fem", *SPEED_SCENE)
     dep = load_dep_material()
-    gold = golds.get(SPEED_SCENE)
-    if dep is None or gold is None or not (iso_dir / "summary.json").exists() or plate is None:
+    if dep is None or plate is None or fem is None or not (iso_dir / "summary.json").exists():
         return None
     iso = GoldCurve(iso_dir)
+    dep_study = single_run_study("fem", dep, lambda dw: np.zeros_like(dw))
+
+    def gap(a, b, key):
+        agreement = C.threshold_agreement(a, b, key) if key != "curve" else C.curve_agreement(a, b)
+        return None if agreement is None else agreement.difference
+
+    plate_dw1_study = plate.dW1.value if plate.dW1 is not None else None
     numbers = {"fem_dep_vs_nu0_dW1": C.threshold_difference(dep, iso),
                "fem_dep_vs_nu0_curve": C.curve_difference_away_from_thresholds(dep, iso),
-               "plate_vs_fem_gold_dW1": C.threshold_difference(plate, gold),
-               "plate_vs_fem_gold_curve": C.curve_difference_away_from_thresholds(plate, gold),
-               "plate_vs_fem_dep_dW1": C.threshold_difference(plate, dep),
-               "plate_vs_fem_dep_curve": C.curve_difference_away_from_thresholds(plate, dep),
+               "plate_vs_fem_gold_dW1": gap(plate, fem, "dW1"),
+               "plate_vs_fem_gold_curve": gap(plate, fem, "curve"),
+               "plate_vs_fem_dep_dW1": (abs(plate_dw1_study - dep.summary["dW1_over_L"])
+                                        if plate_dw1_study is not None and dep.summary.get("dW1_over_L") else None),
+               "plate_vs_fem_dep_curve": gap(plate, dep_study, "curve"),
                "fem_dep_resolution": dep.summary["scene"]["resolution"],
-               "plate_triangles": plate.summary["mesh"]["triangles"]}
+               "plate_triangles": plate.finest.size}
     if any(v is None or not math.isfinite(v) for v in numbers.values()):
         return None
-    plates = [(run.summary["mesh"]["triangles"], run.summary["dW1_over_L"]) for spec, run in results.items()
-              if spec.model == "plate" and (spec.compression_ratio, spec.width_ratio) == SPEED_SCENE
-              and not spec.poisson_ratio and run.summary.get("dW1_over_L") is not None]
-    trend = (MeshTrend(plates, gold.summary["dW1_over_L"])
-             if gold.summary.get("dW1_over_L") is not None and plates else None)
+    points = [(m.size, m.dW1) for m in plate.meshes if m.dW1 is not None]
+    trend = MeshTrend(points, fem.dW1.value) if fem.dW1 is not None and points else None
     return MaterialCheck(**numbers, mesh_trend=trend)
 
 
@@ -550,28 +557,48 @@ def _missing(**inputs) -> str:
     return ", ".join(f"no {name}" for name, value in inputs.items() if value is None)
 
 
+def rod_study(results, profile) -> Study | None:
+    """The rod's study at W/L = 1/20, dL/L = 1/2 from the profile's convergence runs."""
+    resolutions = [n for n in profile.convergence.get("rod", ()) if find_run(results, "rod", 0.5, 1 / 20, n)]
+    return study_from_runs("rod", [find_run(results, "rod", 0.5, 1 / 20, n) for n in resolutions], resolutions)
+
+
+def dep_material_study(fem) -> Study | None:
+    """The FEM shell with the plate's material (data/fem_dep, one mesh) as a study whose error bar
+    is the measured error of the nu = 0 shell on the same mesh (data/fem_fine against the FEM gold
+    study's converged curve); None where any is missing."""
+    dep, iso_dir = load_dep_material(), FEM_FINE / "dL0.5_W0.1667_N90"
+    if dep is None or fem is None or fem.curve is None or not (iso_dir / "summary.json").exists():
+        return None
+    iso = single_run_study("fem", GoldCurve(iso_dir), lambda dw: np.zeros_like(dw))
+
+    def error_of(dw):
+        return np.abs(np.interp(dw, iso.curve.dw, iso.curve.value) - np.interp(dw, fem.curve.dw, fem.curve.value))
+
+    return single_run_study("fem", dep, error_of)
+
+
 def evaluate_claims(results, profile, golds) -> list[dict]:
-    """Every claim of validation/claims.py on this report's runs; a claim whose runs or reference
-    data are not in this profile does not hold (reason "no data: ..." naming what is missing)."""
+    """Every claim of validation/claims.py: the single-model claims on this report's runs, the
+    cross-model claims on converged values (the stored FEM and plate studies, the rod study of this
+    report's convergence runs). A claim whose runs or reference data are not there does not hold
+    (reason "no data: ..." naming what is missing)."""
     get = lambda m, c, w: find_run(results, m, c, w, profile.models.get(m))  # noqa: E731
     res = lambda m: "" if profile.models.get(m) is None else f", resolution {profile.models[m]}"  # noqa: E731
     out = []
     rod = find_run(results, "rod", 0.5, 1 / 20, 100)  # the claims are stated for M = 100
     rod_quarter = find_run(results, "rod", 0.25, 1 / 20, 100)
-    plate6, plate20 = get("plate", 0.5, 1 / 6), get("plate", 0.5, 1 / 20)
-    plate6_fine = find_run(results, "plate", *SPEED_SCENE, CROSS_MODEL_PLATE)
+    plate6 = get("plate", 0.5, 1 / 6)
     gold6 = golds.get((0.5, 1 / 6))
-    dep6 = load_dep_material()
     ribbon = get("ribbon", 0.5, 1 / 20)
+    rods = rod_study(results, profile)
+    dep6 = dep_material_study(load_study("fem", *SPEED_SCENE))
     names = {
         "rod": "rod run (M = 100, W/L = 1/20, dL/L = 1/2)",
         "rod_quarter": "rod run (M = 100, W/L = 1/20, dL/L = 1/4)",
         "plate6": f"plate run (W/L = 1/6, dL/L = 1/2{res('plate')})",
-        "plate20": f"plate run (W/L = 1/20, dL/L = 1/2{res('plate')})",
-        "plate6_fine": f"plate run (W/L = 1/6, dL/L = 1/2, resolution {CROSS_MODEL_PLATE})",
         "ribbon": f"ribbon run (W/L = 1/20, dL/L = 1/2{res('ribbon')})",
         "gold6": "FEM gold data (data/fem_gold/dL0.5_W0.1667)",
-        "dep6": "FEM run with the plate's material (data/fem_dep/dL0.5_W0.1667_N90)",
     }
 
     def lacking(**inputs) -> str:
@@ -581,17 +608,9 @@ def evaluate_claims(results, profile, golds) -> list[dict]:
     out.append(C.evaluate("plate_elastica", C.elastica_error(plate6) if plate6 else None, lacking(plate6=plate6)))
     out.append(C.evaluate("ribbon_elastica", C.elastica_error(ribbon) if ribbon else None, lacking(ribbon=ribbon)))
     out.append(C.evaluate("fem_elastica", C.elastica_error(gold6) if gold6 else None, lacking(gold6=gold6)))
-    out.append(C.evaluate("rod_vs_plate_narrow_U", C.u_branch_difference(plate20, rod) if plate20 and rod else None,
-                          lacking(plate20=plate20, rod=rod)))
-    fine = lacking(plate6_fine=plate6_fine, gold6=gold6)
-    out.append(C.evaluate("plate_vs_fem_curve", C.curve_difference_away_from_thresholds(plate6_fine, gold6)
-                          if plate6_fine and gold6 else None, fine))
-    dw1 = C.threshold_difference(plate6_fine, gold6) if plate6_fine and gold6 else None
-    out.append(C.evaluate("plate_vs_fem_dW1", dw1, fine or "dW1 not located in the plate run or the FEM gold"))
-    out.append(C.evaluate("plate_vs_fem_own_material_curve", C.curve_difference_away_from_thresholds(plate6_fine, dep6)
-                          if plate6_fine and dep6 else None, lacking(plate6_fine=plate6_fine, dep6=dep6)))
-    rods = [r for r in (rod, rod_quarter) if r is not None]
-    errors = [C.paper_threshold_error(r) for r in rods]
+    out += C.cross_model_verdicts(rods, dep6)
+    rods_paper = [r for r in (rod, rod_quarter) if r is not None]
+    errors = [C.paper_threshold_error(r) for r in rods_paper]
     out.append(C.evaluate("rod_thresholds_paper", max(errors) if len(errors) == 2 and None not in errors else None,
                           lacking(rod=rod, rod_quarter=rod_quarter) or "a threshold the paper quotes was not located"))
     dw1_sixth = plate6.summary.get("dW1_over_L") if plate6 else None

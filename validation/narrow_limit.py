@@ -1,0 +1,152 @@
+"""The narrow strip against the rod (issue 16 item 5): is the narrow plate's and shell's dW2 below
+the rod's physics or discretisation?
+
+At W/L = 1/20, dL/L = 1/2 and the paper's L/b = 1181, W^2/(b L) = 2.95: a strip that wide relative
+to sqrt(b L) is not a rod, since its cross-section bends (anticlastic and membrane effects grow with
+W^2/(b L)). A rod's normalised thresholds do not depend on L/b; a plate's and a shell's should
+approach the rod's as W^2/(b L) -> 0 at fixed W/L, if the gap is physics.
+
+`python -m validation.narrow_limit [--out data/narrow_limit] [--slenderness 1181.10236 300 100]`
+runs, at each L/b, the FEM shell (fem_reference simulate, 64 x 8 and 96 x 12 elements), the DDG
+plate (exactly equilateral meshes of 8 and 12 rows) and the rod (M = 100, 200; once, it does not
+depend on L/b) through the README's path (40 compression and 120 shear steps to dW_max, no branch
+tracing) into OUT/Lb<L/b>/<model>_<mesh>/ (path.csv, summary.json; at the paper's L/b the FEM and plate
+runs are those of data/fem_gold and data/plate_gold), then writes OUT/narrow_limit.json
+and OUT/narrow_limit.md: dW1/L and dW2/L per model and mesh, with W^2/(b L). Resumable run by run
+(a finished run is kept); the FEM runs in a subprocess, so dolfinx stays inside fem_reference.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from ddg.output.io import atomic_write_text, read_json_object
+
+WIDTH_RATIO = 1 / 20
+COMPRESSION_RATIO = 1 / 2
+PAPER_SLENDERNESS = 1181.1023622047244
+FEM_MESHES = ((64, 8), (96, 12))
+PLATE_ROWS = (8, 12)
+ROD_RESOLUTIONS = (100, 200)
+
+
+def _finished(folder: Path) -> dict | None:
+    summary = read_json_object(folder / "summary.json")
+    return summary if summary and summary.get("status") in ("complete", "stopped") else None
+
+
+def run_fem(folder: Path, slenderness: float, along: int, across: int) -> dict | None:
+    """One FEM shell run (subprocess: python -m fem_reference simulate), or its stored summary."""
+    if (done := _finished(folder)) is not None:
+        return done
+    command = [sys.executable, "-m", "fem_reference", "simulate", "--width-ratio", repr(WIDTH_RATIO),
+               "--compression-ratio", repr(COMPRESSION_RATIO), "--slenderness", repr(slenderness),
+               "--resolution", str(along), "--across", str(across), "--no-fields", "--quiet", "--out", str(folder)]
+    subprocess.run(command, check=False)
+    return _finished(folder)
+
+
+def run_ddg(folder: Path, model: str, slenderness: float, resolution: int) -> dict | None:
+    """One DDG run (plate: an equilateral mesh of `resolution` rows; rod: M = resolution)."""
+    if (done := _finished(folder)) is not None:
+        return done
+    import ddg
+    from ddg.geometry.plate_mesh import equilateral_mesh
+
+    strip = ddg.Strip.from_ratios(WIDTH_RATIO, COMPRESSION_RATIO, slenderness)
+    protocol = ddg.LoadingProtocol(COMPRESSION_RATIO)
+    if model == "plate":
+        mesh = equilateral_mesh(strip.length, strip.width, resolution)
+        ddg.simulate(strip, protocol, model="plate", mesh=mesh, out=folder, branches=False, progress=False)
+    else:
+        ddg.simulate(strip, protocol, model="rod", resolution=resolution, out=folder, branches=False, progress=False)
+    return _finished(folder)
+
+
+def runs(slenderness: float) -> list[tuple[str, str, int, int | None]]:
+    """(model, folder name, resolution, across) of the runs at one L/b."""
+    out = [("fem", f"fem_N{a}x{c}", a, c) for a, c in FEM_MESHES]
+    out += [("plate", f"plate_R{r}", r, None) for r in PLATE_ROWS]
+    if abs(slenderness - PAPER_SLENDERNESS) < 1e-6:
+        out += [("rod", f"rod_M{m}", m, None) for m in ROD_RESOLUTIONS]
+    return out
+
+
+def slenderness_name(slenderness: float) -> str:
+    return f"Lb{slenderness:.0f}"
+
+
+def run_folder(out: Path, slenderness: float, model: str, name: str) -> Path:
+    """Where a run is: at the paper's L/b the FEM and plate runs are those of the mesh studies
+    (data/fem_gold, data/plate_gold: the same meshes and path), elsewhere OUT/Lb<L/b>/<name>."""
+    if abs(slenderness - PAPER_SLENDERNESS) < 1e-6 and model in ("fem", "plate"):
+        from .estimates import STUDY_ROOTS
+        from .reference import gold_name
+
+        mesh = name.split("_", 1)[1]
+        return STUDY_ROOTS[model] / gold_name(COMPRESSION_RATIO, WIDTH_RATIO) / mesh
+    return out / slenderness_name(slenderness) / name
+
+
+def table(out: Path, slendernesses) -> list[dict]:
+    """One row per finished run: L/b, W^2/(b L), model, mesh, dW1/L, dW2/L, status, wall time."""
+    rows = []
+    for s in slendernesses:
+        for model, name, resolution, across in runs(s):
+            summary = _finished(run_folder(out, s, model, name))
+            if summary is None:
+                continue
+            rows.append({"slenderness": s, "width_squared_over_thickness_length": WIDTH_RATIO**2 * s,
+                         "model": model, "mesh": name.split("_", 1)[1], "dW1_over_L": summary.get("dW1_over_L"),
+                         "dW2_over_L": summary.get("dW2_over_L"), "status": summary.get("status"),
+                         "wall_time_s": summary.get("wall_time_s")})
+    return rows
+
+
+def write_table(out: Path, rows: list[dict]) -> None:
+    atomic_write_text(out / "narrow_limit.json", json.dumps(rows, indent=2) + "\n")
+
+    def f(v):
+        return "–" if v is None else f"{v:.4f}"
+
+    lines = [f"# Narrow strip against the rod: W/L = {WIDTH_RATIO:g}, dL/L = {COMPRESSION_RATIO:g}", "",
+             "| L/b | W^2/(b L) | model | mesh | dW1/L | dW2/L | status | wall s |",
+             "|---:|---:|---|---|---:|---:|---|---:|"]
+    for r in rows:
+        lines.append(f"| {r['slenderness']:.0f} | {r['width_squared_over_thickness_length']:.3f} | {r['model']} | "
+                     f"{r['mesh']} | {f(r['dW1_over_L'])} | {f(r['dW2_over_L'])} | {r['status']} | "
+                     f"{(r['wall_time_s'] or 0):.0f} |")
+    lines += ["", "The rod's normalised thresholds do not depend on L/b (its bending and twisting stiffnesses "
+              "both scale with b^3); it is run at the paper's L/b only."]
+    atomic_write_text(out / "narrow_limit.md", "\n".join(lines) + "\n")
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m validation.narrow_limit", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", default="data/narrow_limit")
+    parser.add_argument("--slenderness", type=float, nargs="+", default=[PAPER_SLENDERNESS, 300.0, 100.0])
+    args = parser.parse_args(argv)
+    bad = [s for s in args.slenderness if not 20.0 <= s <= 1e5]
+    if bad:
+        parser.exit(2, f"--slenderness {bad[0]:g} is outside [20, 1e5]\n")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    for s in args.slenderness:
+        for model, name, resolution, across in runs(s):
+            folder = run_folder(out, s, model, name)
+            t0 = time.perf_counter()
+            summary = (run_fem(folder, s, resolution, across) if model == "fem"
+                       else run_ddg(folder, model, s, resolution))
+            print(f"L/b {s:.0f} {name}: {None if summary is None else summary.get('status')}, "
+                  f"{time.perf_counter() - t0:.0f} s, dW1/L {(summary or {}).get('dW1_over_L')}, "
+                  f"dW2/L {(summary or {}).get('dW2_over_L')}", flush=True)
+            write_table(out, table(out, args.slenderness))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -2,8 +2,9 @@
 bars, FEM shell against DDG plate, beside the paper's quoted values and the rod:
 `python -m validation.benchmark [--out data/benchmark] [--no-rod]`.
 
-The ten scenes are dL/L in {1/2, 1/4} x W/L in {1/20, 1/12, 1/6, 1/3, 1/2} at L/b = 1181
-(validation.studies.COMPRESSIONS x WIDTHS_GOLD). For each one the FEM and plate values are the
+The ten scenes are dL/L in {1/2, 1/4} x W/L in {1/20, 1/12, 1/6, 1/3, 1/2}, at the paper's strip
+(L = 0.15 m for dL/L = 1/2 and 0.10 m for 1/4, b = 0.127 mm: L/b = 1181 and 787;
+validation.studies.COMPRESSIONS x WIDTHS_GOLD). For each one the FEM and plate values are the
 converged values of their stored mesh studies (data/fem_gold and data/plate_gold, read by
 validation.estimates.load_study; fem_reference.convergence.estimate: Richardson with the observed
 order and Roache's grid convergence index where the sequence is asymptotic, else the finest value

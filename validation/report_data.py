@@ -119,7 +119,7 @@ class ReportData:
     """Everything the report states; the templates only lay it out."""
     provenance: Provenance
     claims: list[dict]                  # rows of validation.claims.evaluate
-    tables: dict[str, Table]            # claims, thresholds, speed_accuracy, convergence, stability_map
+    tables: dict[str, Table]            # claims, thresholds, speed_accuracy, convergence, stability_map, benchmark
     speed_reference: str
     poisson: dict[float, dict]          # nu -> its curve's and dW1's difference from nu = 0
     material: MaterialCheck | None
@@ -552,6 +552,21 @@ def material_check(results, golds) -> MaterialCheck | None:
     return MaterialCheck(**numbers, mesh_trend=trend)
 
 
+def benchmark_table() -> Table:
+    """The benchmark (validation.benchmark): converged thresholds of the ten scenes from the stored
+    FEM and plate studies, with the rod's stored study (data/benchmark/rod_thresholds.json) where
+    it exists."""
+    from ddg.output.io import read_json_object
+
+    from .benchmark import ROD_FILE, benchmark_rows
+    from .reference import ROOT
+
+    rows = benchmark_rows(rod_thresholds=read_json_object(ROOT / "data" / "benchmark" / ROD_FILE) or None)
+    columns = list(rows[0].keys()) if rows else []
+    shown = [c for c in columns if not c.endswith(("_basis", "_meshes"))]
+    return Table("benchmark", columns, rows, csv=True, shown=shown)
+
+
 def _missing(**inputs) -> str:
     """What a claim lacks: the names of the inputs that are None, joined ('' if none is)."""
     return ", ".join(f"no {name}" for name, value in inputs.items() if value is None)
@@ -661,6 +676,7 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
         "convergence": Table("convergence", list(conv[0].keys()) if conv else [], conv),
         "stability_map": Table("stability_map", smap_columns, smap, csv=True,
                                shown=[c for c in smap_columns if c != "message"]),
+        "benchmark": benchmark_table(),
     }
     provenance = Provenance(profile.name, len(results), len(set(all_specs)), len(all_specs),
                             sorted(golds), sorted(scene for scene in scenes if scene not in golds))

@@ -199,10 +199,10 @@ def write_scene_study(folder: Path, meshes=None) -> dict | None:
 
 
 def finest_run(folder: Path) -> Path | None:
-    """The scene's reference run: the single run at the folder's top level where there is one
-    (the layout before the mesh studies, kept as the validation's reference until the claims
-    compare extrapolated values, issue 16 item 4), else the finest finished run of the study
-    (N<along>x<across>), else None."""
+    """The scene's reference run for the report's H_mid figures: the single run at the folder's top
+    level where there is one (the layout before the mesh studies), else the finest finished run of
+    the study (N<along>x<across>), else None. The claims and the benchmark use the studies'
+    converged values instead (validation.estimates)."""
     if (folder / "summary.json").exists():
         return folder
     found = scene_runs(folder)
@@ -251,9 +251,10 @@ dL0.5_W0.5, dL0.25_W0.05, ...) is run on three meshes refined by 1.5 in both dir
 and dW2 bisected to 1e-4 L. Each run folder N<along>x<across>/ holds path.csv, summary.json and
 centerline.csv (the DDG output contract); the scene folder holds the study: richardson.json,
 convergence.md. A scene folder with a single run at its top level is from before the studies
-(60 elements, dW2 to 1e-3 L) and stays the validation's reference until the claims compare
-extrapolated values. Runs of other meshes in a scene folder are kept as evidence (W/L = 1/6:
-40 x 8, 60 x 12, 90 x 18, not asymptotic: convergence_40_60_90.md) and are not part of its study.
+(60 elements, dW2 to 1e-3 L); the report's H_mid figures still draw it, while the claims and the
+benchmark use the studies' converged values (validation/estimates.py). Runs of other meshes in a
+scene folder are kept as evidence (W/L = 1/6: 40 x 8, 60 x 12, 90 x 18, not asymptotic:
+convergence_40_60_90.md) and are not part of its study.
 
 Error bars (fem_reference.convergence.estimate): with three meshes whose differences shrink
 monotonically and an observed order p in [1, 4], the value is the Richardson extrapolation and

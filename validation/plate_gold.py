@@ -1,5 +1,7 @@
 """Mesh studies of the DDG plate on the benchmark scenes (issue 16 item 2):
-`python -m validation.plate_gold --out data/plate_gold [--only NAME ...] [--levels K]`.
+`python -m validation.plate_gold --out data/plate_gold [--only NAME ...] [--levels K]
+[--model plate|plate-midedge]` (the mid-edge plate on ghost-clamp meshes of the same rows, e.g. into
+data/midedge_gold).
 
 Each of the ten scenes of fem_reference.gold (dL/L in {1/2, 1/4} x W/L in {1/20, 1/12, 1/6, 1/3,
 1/2}, L/b = 1181) is run with the plate on LEVELS exactly equilateral meshes
@@ -39,9 +41,24 @@ def _finished(folder: Path) -> bool:
     return bool(summary) and summary.get("status") in ("complete", "stopped")
 
 
-def run_scene(out: Path, name: str, compression: float, width: float, levels: int, quiet: bool) -> int:
+#: The plate models a study can run, with the mesh each needs (rows of triangles across W given).
+MODELS = {"plate": "equilateral structured (ddg.geometry.plate_mesh.equilateral_mesh)",
+          "plate-midedge": "ghost-clamp structured (ddg.geometry.plate_mesh.ghost_clamp_mesh)"}
+TITLES = {"plate": "Plate", "plate-midedge": "Mid-edge plate"}
+
+
+def model_mesh(model: str, length: float, width: float, rows: int):
+    """The study mesh of `model` with `rows` rows of triangles across W."""
+    from ddg.geometry.plate_mesh import equilateral_mesh, ghost_clamp_mesh
+
+    if model == "plate-midedge":
+        return ghost_clamp_mesh(length, width, rows=rows)
+    return equilateral_mesh(length, width, rows)
+
+
+def run_scene(out: Path, name: str, compression: float, width: float, levels: int, quiet: bool,
+              model: str = "plate") -> int:
     import ddg
-    from ddg.geometry.plate_mesh import equilateral_mesh
 
     status = 0
     for rows in rows_sequence(width, levels):
@@ -50,19 +67,19 @@ def run_scene(out: Path, name: str, compression: float, width: float, levels: in
             continue
         strip = ddg.Strip.from_ratios(width, compression)
         t0 = time.perf_counter()
-        result = ddg.simulate(strip, ddg.LoadingProtocol(compression), model="plate",
-                              mesh=equilateral_mesh(strip.length, strip.width, rows), out=target, branches=False)
+        result = ddg.simulate(strip, ddg.LoadingProtocol(compression), model=model,
+                              mesh=model_mesh(model, strip.length, strip.width, rows), out=target, branches=False)
         if not quiet:
             s = result.summary
             print(f"{name} R{rows} ({s['mesh']['triangles']} triangles): {s['status']}, "
                   f"{time.perf_counter() - t0:.0f} s, dW1/L {s['dW1_over_L']}, dW2/L {s['dW2_over_L']}", flush=True)
         status = status or (0 if result.converged else 3)
-        write_scene_study(out / name, rows_sequence(width, levels))
-        write_index(out)
+        write_scene_study(out / name, rows_sequence(width, levels), model)
+        write_index(out, model)
     return status
 
 
-def write_scene_study(folder: Path, sequence: list[int]) -> dict | None:
+def write_scene_study(folder: Path, sequence: list[int], model: str = "plate") -> dict | None:
     """richardson.json and convergence.md of one scene from its finished runs of `sequence`."""
     from ddg.output.io import StoredRun
     from fem_reference.convergence import study_estimates
@@ -74,7 +91,7 @@ def write_scene_study(folder: Path, sequence: list[int]) -> dict | None:
     resolutions = [rows for rows, _ in found]
     estimates = study_estimates(runs, resolutions)
     scene = runs[-1].summary["scene"]
-    study = {"model": "plate", "mesh": "equilateral structured (ddg.geometry.plate_mesh.equilateral_mesh)",
+    study = {"model": model, "mesh": MODELS[model],
              "scene": {k: scene[k] for k in ("width_ratio", "compression_ratio", "slenderness")},
              "meshes": [{"rows": rows, "folder": path.name, "status": run.summary["status"],
                          "triangles": run.summary["mesh"]["triangles"], "wall_time_s": run.summary["wall_time_s"],
@@ -84,7 +101,8 @@ def write_scene_study(folder: Path, sequence: list[int]) -> dict | None:
                         for (rows, path), run in zip(found, runs)],
              "refinement_ratio": REFINEMENT, **estimates}
     atomic_write_text(folder / "richardson.json", json.dumps(study, indent=2) + "\n")
-    lines = [f"# Plate mesh study: W/L = {scene['width_ratio']:.4g}, dL/L = {scene['compression_ratio']:g}", "",
+    title = f"# {TITLES[model]} mesh study: W/L = {scene['width_ratio']:.4g}, dL/L = {scene['compression_ratio']:g}"
+    lines = [title, "",
              "| rows across W | triangles | status | dW1/L | dW2/L | H_mid/L compressed | wall s | Newton its |",
              "|---:|---:|---|---:|---:|---:|---:|---:|"]
     for m in study["meshes"]:
@@ -105,7 +123,7 @@ def _fmt(value, spec="{:.4f}"):
     return "-" if not isinstance(value, (int, float)) or isinstance(value, bool) else spec.format(value)
 
 
-def write_index(out: Path) -> None:
+def write_index(out: Path, model: str = "plate") -> None:
     from fem_reference.gold import scenes
 
     index = {}
@@ -117,9 +135,9 @@ def write_index(out: Path) -> None:
                            "wall_time_s": sum(m["wall_time_s"] for m in study["meshes"]),
                            **{k: study.get(k) for k in ("dW1", "dW2", "H_mid_compressed")}}
     atomic_write_text(out / "index.json", json.dumps(index, indent=2) + "\n")
-    lines = ["# DDG plate mesh studies (validation/plate_gold.py)", "",
-             "Regenerate (run by run, finished runs kept): `.venv/bin/python -m validation.plate_gold --out "
-             "data/plate_gold`. Meshes: exactly equilateral, rows across W 8/12/18 (W/L <= 1/6) or 16/24/36; "
+    lines = [f"# DDG {TITLES[model].lower()} mesh studies (validation/plate_gold.py)", "",
+             f"Regenerate (run by run, finished runs kept): `.venv/bin/python -m validation.plate_gold --model {model} "
+             f"--out {out}`. Meshes: {MODELS[model]}, rows across W 8/12/18 (W/L <= 1/6) or 16/24/36; "
              "error bars as the FEM gold's (data/fem_gold/README.md).", "",
              "| scene | rows | triangles | dW1/L | +- | order | dW2/L | +- | order | wall s |",
              "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"]
@@ -145,6 +163,7 @@ def main(argv=None) -> int:
     parser.add_argument("--only", nargs="*", default=None)
     parser.add_argument("--levels", type=int, default=LEVELS)
     parser.add_argument("--quiet", action="store_true")
+    parser.add_argument("--model", choices=sorted(MODELS), default="plate")
     args = parser.parse_args(argv)
     known = [name for name, _, _ in scenes()]
     try:
@@ -161,8 +180,8 @@ def main(argv=None) -> int:
     for name, compression, width in scenes():
         if args.only and name not in args.only:
             continue
-        status = run_scene(out, name, compression, width, args.levels, args.quiet) or status
-    write_index(out)
+        status = run_scene(out, name, compression, width, args.levels, args.quiet, args.model) or status
+    write_index(out, args.model)
     return status
 
 

@@ -59,6 +59,16 @@ def test_plate_dW1_converges_at_second_order_on_the_narrow_scenes(scene):
     assert dw1.error_bar < 0.005, dw1
 
 
+@pytest.mark.parametrize("scene", [(0.5, 1 / 20), (0.5, 1 / 12), (0.5, 1 / 6), (0.25, 1 / 20), (0.25, 1 / 12)])
+def test_plate_H_mid_converges_at_second_order_on_U(scene):
+    """H_mid on U (0.05 < dW/L < dW1 - 0.02), point by point on 8/12/18 rows: median observed order
+    3.00, 2.43, 1.99, 2.49, 2.33 on the scenes in order (16-39 asymptotic points each; at W/L = 1/2,
+    dL/L = 1/2 it is 1.44 on 18 points, below the target, and not asserted here)."""
+    orders, points = _study("plate", *scene).u_branch_orders()
+    assert len(orders) >= 10, (len(orders), points)
+    assert ORDER_WINDOW[0] <= np.median(orders) <= ORDER_WINDOW[1], np.median(orders)
+
+
 def test_fem_dW1_converges_on_the_narrow_scene():
     """FEM on 64/96/144 elements at W/L = 1/20, dL/L = 1/2: dW1 0.3355/0.3444/0.3485, order 1.84."""
     dw1 = _study("fem", 0.5, 1 / 20).dW1
@@ -98,3 +108,11 @@ def test_gold_scene_converges_with_the_mesh(tmp_path):
         assert abs(float(meshes[-1][key]) - float(extrapolated[key])) < 0.005, key
     for key in ("order_dW1", "order_dW2"):
         assert np.isfinite(float(extrapolated[key])), key
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "issue 16 item 3 target not met at W/L = 1/2, dL/L = 1/2: the plate's H_mid on U (16/24/36 rows) has a "
+    "median observed order of 1.44 over its 18 asymptotic points (1.99 at W/L = 1/6, asserted above)"))
+def test_plate_H_mid_converges_at_order_1_8_on_U_at_one_half():
+    orders, _ = _study("plate", 0.5, 1 / 2).u_branch_orders()
+    assert len(orders) >= 10 and np.median(orders) >= 1.8, np.median(orders)

@@ -47,10 +47,13 @@ class Estimate:
 
 @dataclass(frozen=True)
 class Curve:
-    """H_mid/L against dW/L with a pointwise error bar (arrays of equal length, dW increasing)."""
+    """H_mid/L against dW/L with a pointwise error bar (arrays of equal length, dW increasing), and
+    each point's observed order (nan where none) and whether its sequence was asymptotic."""
     dw: np.ndarray
     value: np.ndarray
     error_bar: np.ndarray
+    order: np.ndarray | None = None
+    asymptotic: np.ndarray | None = None
 
     def at(self, dw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(value, error bar) linearly interpolated at dw (inside the curve's range)."""
@@ -118,6 +121,15 @@ class Study:
         diff = np.abs(np.interp(self.curve.dw[keep], dw[order], h[order]) - self.curve.value[keep])
         return float(np.max(diff + self.curve.error_bar[keep]))
 
+    def u_branch_orders(self, start: float = 0.05, band: float = 0.02) -> tuple[np.ndarray, int]:
+        """Observed orders of H_mid at the asymptotic points of the U branch (start < dW/L < dW1 -
+        band; H_mid barely moves below `start`, so its differences there are rounding), and how
+        many points that range has."""
+        if self.curve is None or self.dW1 is None or self.curve.order is None:
+            return np.empty(0), 0
+        inside = (self.curve.dw > start) & (self.curve.dw < self.dW1.value - band)
+        return self.curve.order[inside & self.curve.asymptotic], int(inside.sum())
+
     def thresholds(self) -> list[float]:
         return [e.value for e in (self.dW1, self.dW2) if e is not None]
 
@@ -137,12 +149,13 @@ def away_from(dw: np.ndarray, thresholds, band: float) -> np.ndarray:
 
 
 def _curve(entries) -> Curve | None:
-    points = [(c["dW_over_L"], c["value"], c["error_bar"]) for c in entries or []
+    points = [(c["dW_over_L"], c["value"], c["error_bar"], np.nan if c.get("order") is None else c["order"],
+               bool(c.get("asymptotic"))) for c in entries or []
               if c.get("value") is not None and c.get("error_bar") is not None]
     if len(points) < 2:
         return None
-    dw, value, bar = (np.array(v, float) for v in zip(*sorted(points)))
-    return Curve(dw, value, bar)
+    dw, value, bar, order, asymptotic = (np.array(v) for v in zip(*sorted(points)))
+    return Curve(dw.astype(float), value.astype(float), bar.astype(float), order.astype(float), asymptotic.astype(bool))
 
 
 def load_study(model: str, compression_ratio: float, width_ratio: float, root: Path | None = None) -> Study | None:

@@ -193,8 +193,9 @@ def study_from_runs(model: str, runs, resolutions, unit: str = "elements") -> St
     resolutions, runs = [n for n, _ in pairs], [r for _, r in pairs]
     estimates = study_estimates(runs, resolutions)
     scene = runs[-1].summary["scene"]
-    meshes = [MeshResult(f"{model[0].upper()}{n}", int(n), unit, r.summary.get("dW1_over_L"),
-                         r.summary.get("dW2_over_L")) for n, r in zip(resolutions, runs)]
+    prefix = "M" if model in ("rod", "ribbon") else "N"   # M: the rod's nodes, as its CLI names it
+    meshes = [MeshResult(f"{prefix}{n}", int(n), unit, r.summary.get("dW1_over_L"), r.summary.get("dW2_over_L"))
+              for n, r in zip(resolutions, runs)]
     return Study(model, float(scene["compression_ratio"]), float(scene["width_ratio"]), meshes,
                  Estimate.of(estimates.get("dW1")), Estimate.of(estimates.get("dW2")),
                  _curve(estimates.get("H_mid_curve")), "runs of this report", runs=list(runs))

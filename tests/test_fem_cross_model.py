@@ -116,3 +116,20 @@ def test_gold_scene_converges_with_the_mesh(tmp_path):
 def test_plate_H_mid_converges_at_order_1_8_on_U_at_one_half():
     orders, _ = _study("plate", 0.5, 1 / 2).u_branch_orders()
     assert len(orders) >= 10 and np.median(orders) >= 1.8, np.median(orders)
+
+
+def _mesh_near(study, triangles):
+    """The study's mesh whose triangle count is nearest `triangles`."""
+    return min(study.meshes, key=lambda m: abs(m.size - triangles))
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "issue 16 item 3 target not met at W/L = 1/6, dL/L = 1/2: at about 2000 triangles dW1/L is 0.2503 for the "
+    "paper's plate (2100 triangles) and 0.2715 for the mid-edge plate (2150), 0.0143 and 0.0069 from the FEM's "
+    "0.2646 +- 0.0011"))
+@pytest.mark.parametrize("model", ["plate", "plate-midedge"])
+def test_plate_dW1_at_2000_triangles_within_0_005_of_the_fem(model):
+    fem, study = _study("fem", 0.5, 1 / 6), _study(model, 0.5, 1 / 6)
+    mesh = _mesh_near(study, 2000)
+    assert abs(mesh.size - 2000) < 300 and mesh.dW1 is not None
+    assert abs(mesh.dW1 - fem.dW1.value) <= 0.005, (mesh.label, mesh.dW1, fem.dW1.value)

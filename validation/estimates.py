@@ -22,7 +22,8 @@ from ddg.output.io import StoredRun
 from .reference import FEM_GOLD, ROOT, gold_name
 
 PLATE_GOLD = ROOT / "data" / "plate_gold"
-STUDY_ROOTS = {"fem": FEM_GOLD, "plate": PLATE_GOLD}
+MIDEDGE_GOLD = ROOT / "data" / "midedge_gold"
+STUDY_ROOTS = {"fem": FEM_GOLD, "plate": PLATE_GOLD, "plate-midedge": MIDEDGE_GOLD}
 
 
 @dataclass(frozen=True)
@@ -159,8 +160,9 @@ def _curve(entries) -> Curve | None:
 
 
 def load_study(model: str, compression_ratio: float, width_ratio: float, root: Path | None = None) -> Study | None:
-    """The stored study of `model` ("fem" or "plate") on a scene: OUT/<scene>/richardson.json of
-    `python -m fem_reference gold` or `python -m validation.plate_gold`; None without one."""
+    """The stored study of `model` ("fem", "plate" or "plate-midedge") on a scene:
+    OUT/<scene>/richardson.json of `python -m fem_reference gold` or `python -m validation.plate_gold
+    [--model plate-midedge]`; None without one."""
     folder = Path(root or STUDY_ROOTS[model]) / gold_name(compression_ratio, width_ratio)
     path = folder / "richardson.json"
     if not path.exists():

@@ -85,15 +85,6 @@ def _shear(run, key: str) -> np.ndarray:
     return np.array([float(r[key]) for r in run.rows if r["stage"] == "shear"])
 
 
-def u_branch_difference(run, other) -> float:
-    """Max |H_mid difference|/L up to 0.02 below the smaller dW1 of the two runs."""
-    limits = [r.summary.get("dW1_over_L") for r in (run, other)]
-    limit = min(v for v in limits if v is not None) - 0.02 if any(v is not None for v in limits) else np.inf
-    dw, h = _shear(run, "dW_over_L"), _shear(run, "H_mid_over_L")
-    keep = dw <= limit
-    return curve_error(dw[keep], h[keep], _shear(other, "dW_over_L"), _shear(other, "H_mid_over_L"))
-
-
 def curve_difference_away_from_thresholds(run, reference) -> float:
     """Max |H_mid difference|/L, 0.02 away from either run's dW1 and dW2 (near a threshold a
     small shift of it is a large difference in H_mid: sqrt(dW - dW1) growth, the snap at dW2)."""

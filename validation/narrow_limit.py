@@ -26,7 +26,7 @@ import sys
 import time
 from pathlib import Path
 
-from ddg.output.io import atomic_write_text, read_json_object
+from ddg.output.io import atomic_write_text, finished_run_summary
 
 WIDTH_RATIO = 1 / 20
 COMPRESSION_RATIO = 1 / 2
@@ -36,25 +36,20 @@ PLATE_ROWS = (8, 12)
 ROD_RESOLUTIONS = (100, 200)
 
 
-def _finished(folder: Path) -> dict | None:
-    summary = read_json_object(folder / "summary.json")
-    return summary if summary and summary.get("status") in ("complete", "stopped") else None
-
-
 def run_fem(folder: Path, slenderness: float, along: int, across: int) -> dict | None:
     """One FEM shell run (subprocess: python -m fem_reference simulate), or its stored summary."""
-    if (done := _finished(folder)) is not None:
+    if (done := finished_run_summary(folder)) is not None:
         return done
     command = [sys.executable, "-m", "fem_reference", "simulate", "--width-ratio", repr(WIDTH_RATIO),
                "--compression-ratio", repr(COMPRESSION_RATIO), "--slenderness", repr(slenderness),
                "--resolution", str(along), "--across", str(across), "--no-fields", "--quiet", "--out", str(folder)]
     subprocess.run(command, check=False)
-    return _finished(folder)
+    return finished_run_summary(folder)
 
 
 def run_ddg(folder: Path, model: str, slenderness: float, resolution: int) -> dict | None:
     """One DDG run (plate: an equilateral mesh of `resolution` rows; rod: M = resolution)."""
-    if (done := _finished(folder)) is not None:
+    if (done := finished_run_summary(folder)) is not None:
         return done
     import ddg
     from ddg.geometry.plate_mesh import equilateral_mesh
@@ -66,7 +61,7 @@ def run_ddg(folder: Path, model: str, slenderness: float, resolution: int) -> di
         ddg.simulate(strip, protocol, model="plate", mesh=mesh, out=folder, branches=False, progress=False)
     else:
         ddg.simulate(strip, protocol, model="rod", resolution=resolution, out=folder, branches=False, progress=False)
-    return _finished(folder)
+    return finished_run_summary(folder)
 
 
 def runs(slenderness: float) -> list[tuple[str, str, int, int | None]]:
@@ -98,7 +93,7 @@ def table(out: Path, slendernesses) -> list[dict]:
     rows = []
     for s in slendernesses:
         for model, name, resolution, across in runs(s):
-            summary = _finished(run_folder(out, s, model, name))
+            summary = finished_run_summary(run_folder(out, s, model, name))
             if summary is None:
                 continue
             rows.append({"slenderness": s, "width_squared_over_thickness_length": WIDTH_RATIO**2 * s,

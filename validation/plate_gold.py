@@ -23,7 +23,7 @@ import json
 import time
 from pathlib import Path
 
-from ddg.output.io import atomic_write_text, read_json_object
+from ddg.output.io import atomic_write_text, finished_run_summary, read_json_object
 
 #: Rows of triangles across W on the coarsest mesh (a multiple of 8: 1.5 and 2.25 times it stay even).
 BASE_ROWS = {1 / 20: 8, 1 / 12: 8, 1 / 6: 8, 1 / 3: 16, 1 / 2: 16}
@@ -37,8 +37,7 @@ def rows_sequence(width_ratio: float, levels: int = LEVELS) -> list[int]:
 
 
 def _finished(folder: Path) -> bool:
-    summary = read_json_object(folder / "summary.json")
-    return bool(summary) and summary.get("status") in ("complete", "stopped")
+    return finished_run_summary(folder) is not None
 
 
 #: The plate models a study can run, with the mesh each needs (rows of triangles across W given).

@@ -64,6 +64,13 @@ def read_json_object(path: Path) -> dict | None:
     return value if isinstance(value, dict) else None
 
 
+def finished_run_summary(folder: Path) -> dict | None:
+    """The summary.json of a run folder whose run ended (status "complete" or "stopped"), else
+    None: the test by which resumable studies keep a finished run and redo any other."""
+    summary = read_json_object(Path(folder) / "summary.json")
+    return summary if summary and summary.get("status") in ("complete", "stopped") else None
+
+
 def _format(value):
     if isinstance(value, (bool, np.bool_)):
         return "1" if value else "0"

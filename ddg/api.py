@@ -195,6 +195,9 @@ def simulate(
     thresholds: bool = True,
     branches: bool | None = None,
     probe: Probe | None = None,
+    tolerance: float | None = None,
+    quantities=None,
+    error_map=None,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
@@ -222,8 +225,19 @@ def simulate(
     column), per-branch summary under the summary key `branches`.
     probe: a ddg.solve.probe.Probe told of every Newton solve of the path and every recorded
     step with its wall time (benchmarks, progress displays).
+    model="auto" with `tolerance` (units of L; `quantities` of dW1, dW2, H_mid, default all;
+    `error_map` a CSV, default $DDG_ERROR_MAP or data/error_map/error_map.csv): the cheapest
+    model and resolution the error map predicts within the tolerance on this scene, or the safe
+    choice outside the map (ddg.advise; simulate_auto), run; summary key `auto` says why.
     """
     _checked_scene(strip, protocol)
+    if isinstance(model, str) and model == "auto":
+        return simulate_auto(strip, protocol, tolerance, quantities, error_map, resolution=resolution, out=out,
+                             options=options, progress=progress, solver=solver, dynamic_options=dynamic_options,
+                             mesh=mesh, frames=frames, thresholds=thresholds, branches=branches, probe=probe)
+    if tolerance is not None or quantities is not None or error_map is not None:
+        raise InputError(f"tolerance = {tolerance!r} (and quantities, error_map) apply to model='auto' only, "
+                         f"not model = {model!r}")
     if not isinstance(solver, str) or solver not in ("static", "dynamic"):
         raise InputError(f"solver = {solver!r} is not available; choose 'static' or 'dynamic'")
     check_model_name(model)
@@ -378,3 +392,75 @@ def simulate_dynamic(strip: Strip, protocol: LoadingProtocol, resolution: int = 
               lambda stage, state: observe(model, state, stage, options.eigenvalues), summary, listeners, folder,
               make_result=make_result)
     return execute(run)
+
+
+def run_candidate(strip: Strip, protocol: LoadingProtocol, model: str, resolution: int, out=None,
+                  options: ContinuationOptions | None = None, progress: bool = False, thresholds: bool = True,
+                  branches: bool = False, probe: Probe | None = None) -> SimulationResult:
+    """One candidate of the error map run as the map runs it (ddg.advise): the rod and the
+    ribbons at M = `resolution` nodes (the Sadowsky ribbon from the flat strip, as `--model
+    ribbon`), the plates on the study mesh of `resolution` rows of triangles across W
+    (ddg.advise.study_mesh); no branch tracing unless asked."""
+    from .advise import study_mesh
+
+    if model in ("plate", "plate-midedge"):
+        return simulate(strip, protocol, model=model, mesh=study_mesh(model, strip, resolution), out=out,
+                        options=options, progress=progress, thresholds=thresholds, branches=branches, probe=probe)
+    if model == "ribbon":
+        return run_ribbon(strip, protocol, "direct", None, resolution, out=out, options=options,
+                          thresholds=thresholds, progress=progress, probe=probe)
+    return simulate(strip, protocol, model=model, resolution=resolution, out=out, options=options, progress=progress,
+                    thresholds=thresholds, branches=branches, probe=probe)
+
+
+def simulate_auto(strip: Strip, protocol: LoadingProtocol, tolerance, quantities=None, error_map=None, *,
+                  resolution=None, out=None, options=None, progress=False, solver="static", dynamic_options=None,
+                  mesh=None, frames=False, thresholds=True, branches=None, probe=None) -> SimulationResult:
+    """ddg.simulate(..., model="auto"): ddg.advise.choose on this scene, then run_candidate with
+    the choice. The safe choice (outside the map, or nothing predicted within the tolerance) runs
+    the plate on both meshes of its convergence pair, the coarser into out/auto_pair/R<rows>, and
+    returns the finer. summary["auto"]: chosen_model, resolution, reason, predicted_errors,
+    basis_scenes, map_file (ddg.advise.Choice.auto_block), and for the safe choice `pair`: both
+    meshes' thresholds and their differences. Inputs are checked before any work."""
+    from .advise import choose
+    from .output.io import check_output_directory, write_summary_json
+
+    if tolerance is None:
+        raise InputError("model = 'auto' needs a tolerance (units of L) in (0, 1], e.g. tolerance=0.01")
+    if resolution is not None or mesh is not None:
+        raise InputError(f"model = 'auto' chooses the resolution and mesh; drop resolution = {resolution!r} "
+                         f"and mesh = {mesh!r}")
+    if solver != "static" or dynamic_options is not None or frames:
+        raise InputError(f"model = 'auto' runs the static solver without frames, not solver = {solver!r}"
+                         + (" with frames" if frames else ""))
+    _checked_flags(progress=progress, thresholds=thresholds)
+    if branches is not None and not isinstance(branches, (bool, np.bool_)):
+        raise InputError(f"branches = {branches!r} must be True, False or None")
+    options = _checked_options(options)
+    if probe is not None and not isinstance(probe, Probe):
+        raise InputError(f"probe = {probe!r} must be a ddg.solve.probe.Probe")
+    protocol.resolved_shear_ratio(strip)
+    choice = choose(strip.width_ratio, protocol.compression_ratio, strip.slenderness, tolerance, quantities,
+                    path=error_map, runnable=set(DEFAULT_RESOLUTION))
+    if out is not None:
+        check_output_directory(out)
+    branches = bool(branches) if branches is not None else False
+    common = dict(options=options, progress=progress, thresholds=thresholds, branches=branches, probe=probe)
+    block = choice.auto_block()
+    if choice.safe:
+        coarse_rows, fine_rows = choice.resolution
+        coarse_out = None if out is None else Path(out) / "auto_pair" / f"R{coarse_rows}"
+        coarse = run_candidate(strip, protocol, choice.model, coarse_rows, out=coarse_out, **common)
+        result = run_candidate(strip, protocol, choice.model, fine_rows, out=out, **common)
+        pair = {"rows": [coarse_rows, fine_rows], "coarse_folder": None if coarse_out is None else str(coarse_out)}
+        for key in ("dW1_over_L", "dW2_over_L", "H_mid_over_L_compressed"):
+            a, b = coarse.summary.get(key), result.summary.get(key)
+            pair[key] = [a, b]
+            pair[f"{key}_difference"] = None if a is None or b is None else abs(b - a)
+        block["pair"] = pair
+    else:
+        result = run_candidate(strip, protocol, choice.model, choice.resolution, out=out, **common)
+    result.summary["auto"] = block
+    if out is not None:
+        write_summary_json(Path(out) / "summary.json", result.summary)
+    return result

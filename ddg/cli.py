@@ -30,7 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m ddg", description="DDG solvers for pre-buckled strips under shear.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sim = sub.add_parser("simulate", help="compress by dL, then shear by dW; write path.csv and summary.json")
-    sim.add_argument("--model", default="rod", choices=("rod", "plate", "plate-midedge", "ribbon"),
+    sim.add_argument("--model", default="rod", choices=("rod", "plate", "plate-midedge", "ribbon", "auto"),
                      help="rod (DAR, default), plate (DEP on a triangle mesh), plate-midedge (mid-edge "
                           "Kirchhoff plate with the material's Poisson ratio) or ribbon (Sadowsky, Eq. A.5)")
     sim.add_argument("--zeta", type=float, default=None,
@@ -74,6 +74,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--max-newton-iterations", type=int, default=15, help="per load step (default 15)")
     sim.add_argument("--out", default="out", help="output directory (default ./out)")
     sim.add_argument("--quiet", action="store_true", help="no progress bar or result print-out")
+    _add_auto_arguments(sim, "--model auto: ")
 
     cur = sub.add_parser("curvatures", help="centerline curvatures k1, k2, tau along s (Figs. A.12-A.14): CSV and PNG")
     cur.add_argument("--model", default="rod", choices=("rod", "plate", "ribbon"),
@@ -90,6 +91,12 @@ def build_parser() -> argparse.ArgumentParser:
     cur.add_argument("--stations", type=int, default=None, help="plate: centerline stations (default ~ columns / 2)")
     cur.add_argument("--out", default="out", help="output directory: curvatures.csv, curvatures.png (default ./out)")
 
+    adv = sub.add_parser("advise", help="the model and resolution the error map predicts within a tolerance on a "
+                                        "scene, with the predicted errors and cost, without running (ddg.advise)")
+    adv.add_argument("--width-ratio", type=float, required=True, help="W/L")
+    adv.add_argument("--compression-ratio", type=float, required=True, help="dL/L")
+    adv.add_argument("--slenderness", type=float, default=None, help="L/b (default: b = 0.127 mm)")
+    _add_auto_arguments(adv, "")
     sub.add_parser("warmup", help="compile and cache the numba kernels once (scripts/setup.sh runs it), "
                                   "so the first run pays no JIT cost")
     err = sub.add_parser("centerline-error",
@@ -283,6 +290,8 @@ def cmd_simulate(args) -> int:
                                args.shear_direction)
     protocol.resolved_shear_ratio(strip)
     check_integer("--max-newton-iterations", args.max_newton_iterations, 1, 1000)
+    if args.model == "auto" or any(v is not None for v in (args.tolerance, args.quantities, args.error_map)):
+        return cmd_simulate_auto(args, strip, protocol)
     check_resolution(args.model, args.resolution, strip, args.mesh)
     _check_zeta(args.zeta)
     if args.mesh is not None and args.model != "plate":
@@ -329,6 +338,79 @@ def cmd_simulate(args) -> int:
     return 0
 
 
+def _add_auto_arguments(parser, prefix: str) -> None:
+    parser.add_argument("--tolerance", default=None,
+                        help=f"{prefix}largest acceptable error of each quantity in units of L, in (0, 1] "
+                             "(error + the reference's error bar, from the error map)")
+    parser.add_argument("--quantities", default=None,
+                        help=f"{prefix}comma-separated quantities the tolerance applies to: dW1, dW2, H_mid "
+                             "(default all three)")
+    parser.add_argument("--error-map", default=None,
+                        help=f"{prefix}the error map CSV (default $DDG_ERROR_MAP or data/error_map/error_map.csv)")
+
+
+def cmd_advise(args) -> int:
+    """`python -m ddg advise`: ddg.advise.choose on the scene, printed; nothing is run."""
+    from .advise import check_quantities, check_tolerance, choose, format_choice, map_file
+    from .api import DEFAULT_RESOLUTION
+
+    if args.tolerance is None:
+        raise InputError("--tolerance is required: the largest acceptable error in units of L, in (0, 1]")
+    tolerance = check_tolerance(args.tolerance)
+    quantities = check_quantities(args.quantities)
+    map_file(args.error_map)
+    choice = choose(args.width_ratio, args.compression_ratio, args.slenderness, tolerance, quantities,
+                    path=args.error_map, runnable=set(DEFAULT_RESOLUTION))
+    print(format_choice(choice))
+    return 0
+
+
+def cmd_simulate_auto(args, strip: Strip, protocol: LoadingProtocol) -> int:
+    """`simulate --model auto --tolerance T`: the choice of ddg.advise run by ddg.simulate; every
+    option is checked before any work (exit 2)."""
+    from .advise import check_quantities, check_tolerance, map_file
+    from .api import simulate
+    from .solve.continuation import ContinuationOptions
+    from .solve.newton import NewtonOptions
+
+    if args.model != "auto":
+        given = next(f"{flag} {v!r}" for flag, v in (("--tolerance", args.tolerance), ("--quantities", args.quantities),
+                                                    ("--error-map", args.error_map)) if v is not None)
+        raise InputError(f"{given} applies to --model auto only, not --model {args.model}")
+    if args.tolerance is None:
+        raise InputError("--model auto needs --tolerance, the largest acceptable error in units of L, in (0, 1]")
+    tolerance = check_tolerance(args.tolerance)
+    quantities = check_quantities(args.quantities)
+    map_file(args.error_map)
+    for flag, value in (("--resolution", args.resolution), ("--mesh", args.mesh), ("--zeta", args.zeta),
+                        ("--ribbon-init", args.ribbon_init), ("--clamp-speed", args.clamp_speed)):
+        if value is not None:
+            raise InputError(f"{flag} {value!r} does not apply to --model auto (the model and resolution are chosen)")
+    if args.frames or args.solver != "static":
+        raise InputError("--model auto runs the static solver without --frames")
+    _output_directory(args.out)
+    options = ContinuationOptions(newton=NewtonOptions(max_iterations=args.max_newton_iterations),
+                                  branch_switching=not args.no_branch_switching,
+                                  branch_sign=1 if args.branch == "+" else -1)
+    result = simulate(strip, protocol, "auto", out=args.out, options=options, progress=not args.quiet,
+                      thresholds=not args.no_thresholds, branches=args.branches, tolerance=tolerance,
+                      quantities=quantities, error_map=args.error_map)
+    s = result.summary
+    if not args.quiet:
+        keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
+                "newton_iterations", "wall_time_s", "converged", "message", "auto")
+        print(json.dumps({k: s.get(k) for k in keys}, indent=2))
+        print(f"wrote {Path(args.out) / 'path.csv'} and {Path(args.out) / 'summary.json'}")
+    auto = s.get("auto") or {}
+    sys.stderr.write(f"auto: {auto.get('chosen_model')} {auto.get('resolution_label')}: {auto.get('reason')}\n")
+    for warning in s.get("warnings") or ():
+        sys.stderr.write(f"warning: {warning}\n")
+    if not result.converged:
+        sys.stderr.write(f"error: run did not complete: {s['message']}; converged part kept in {args.out}\n")
+        return EXIT_NOT_CONVERGED
+    return 0
+
+
 def main(argv=None) -> int:
     """The command line; returns the exit code (0 complete, 2 bad input, 3 not converged,
     130/143 interrupted by SIGINT/SIGTERM with every converged step written, 1 internal error)."""
@@ -347,6 +429,8 @@ def main(argv=None) -> int:
             return cmd_simulate(args)
         if args.command == "curvatures":
             return cmd_curvatures(args)
+        if args.command == "advise":
+            return cmd_advise(args)
         if args.command == "centerline-error":
             return cmd_centerline_error(args)
         if args.command == "sweep":

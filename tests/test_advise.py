@@ -213,3 +213,30 @@ def test_committed_map_wide_strip_gets_a_plate(monkeypatch):
         c = choose(0.5, compression, None, 0.01, runnable=set(ddg.api.DEFAULT_RESOLUTION))
         assert c.model in ("plate", "plate-midedge")
         assert c.safe or all(c.predicted_errors[q] <= 0.01 for q in QUANTITIES)
+
+
+def test_safe_choice_runs_the_plate_pair_and_reports_both(map_csv, tmp_path, monkeypatch):
+    """Outside the map the plate runs on both meshes of its pair (here replaced by tiny rods, to stay
+    fast: what is checked is the calls and the summary, not the plate)."""
+    import ddg.api as api
+
+    calls = []
+    real = api.run_candidate
+
+    def fake(strip, protocol, model, resolution, out=None, **kwargs):
+        calls.append((model, resolution, None if out is None else str(out)))
+        return real(strip, protocol, "rod", 10 + resolution, out=out, **kwargs)
+
+    monkeypatch.setattr(api, "run_candidate", fake)
+    strip = ddg.Strip.from_ratios(0.5, 0.5)
+    out = tmp_path / "safe"
+    result = ddg.simulate(strip, ddg.LoadingProtocol(0.5, 0.05, 3, 2), model="auto", tolerance=0.01,
+                          error_map=map_csv, thresholds=False, out=out)
+    assert [c[:2] for c in calls] == [("plate", 24), ("plate", 36)]
+    assert calls[0][2] == str(out / "auto_pair" / "R24") and calls[1][2] == str(out)
+    auto = json.loads((out / "summary.json").read_text())["auto"]
+    assert auto == json.loads(json.dumps(result.summary["auto"]))
+    assert auto["safe_choice"] and not auto["inside_map"] and auto["resolution"] == [24, 36]
+    assert auto["pair"]["rows"] == [24, 36] and len(auto["pair"]["H_mid_over_L_compressed"]) == 2
+    assert auto["pair"]["H_mid_over_L_compressed_difference"] is not None
+    assert "outside the error map" in auto["reason"]

@@ -1,0 +1,150 @@
+"""validation.error_map: the error columns against a reference study, the resumable table, the
+held-out (leave-one-scene-out) check of ddg.advise's prediction, and the committed map."""
+import csv
+
+import numpy as np
+import pytest
+
+from validation import error_map as em
+from validation.estimates import Curve, Estimate, MeshResult, Study
+
+ROOT = em.ROOT
+COMMITTED = ROOT / "data" / "error_map"
+
+
+def reference(dw1=0.30, dw2=0.45):
+    dw = np.linspace(0.0, 0.6, 61)
+    return Study("fem", 0.5, 0.05, [MeshResult("N96x12", 96, "elements along L", dw1, dw2)],
+                 Estimate(dw1, 0.002), Estimate(dw2, 0.003), Curve(dw, 0.4 - 0.5 * dw, np.full_like(dw, 0.001)),
+                 "synthetic")
+
+
+def run_rows(shift=0.0, bump_at=None, upto=0.6):
+    rows = [{"stage": "compression", "dW_over_L": 0.0, "H_mid_over_L": 0.0}]
+    for x in np.linspace(0.0, upto, 121):
+        h = 0.4 - 0.5 * x + shift + (0.2 if bump_at is not None and abs(x - bump_at) < 0.011 else 0.0)
+        rows.append({"stage": "shear", "dW_over_L": float(x), "H_mid_over_L": float(h)})
+    return rows
+
+
+def test_errors_against_the_reference_and_its_error_bars():
+    summary = {"status": "complete", "dW1_over_L": 0.31, "dW2_over_L": 0.44}
+    e = em.row_errors(reference(), summary, run_rows(shift=0.004))
+    assert e["dW1_error"] == pytest.approx(0.01) and e["dW1_bound"] == pytest.approx(0.012)
+    assert e["dW2_error"] == pytest.approx(0.01) and e["dW2_bound"] == pytest.approx(0.013)
+    assert e["H_mid_error"] == pytest.approx(0.004) and e["H_mid_bound"] == pytest.approx(0.005)
+    assert e["H_mid_ref_error_bar"] == pytest.approx(0.001) and e["reason"] == ""
+
+
+def test_the_band_about_the_reference_thresholds_is_left_out():
+    summary = {"status": "complete", "dW1_over_L": 0.30, "dW2_over_L": 0.45}
+    near = em.row_errors(reference(), summary, run_rows(bump_at=0.305))   # within 0.02 of dW1: ignored
+    far = em.row_errors(reference(), summary, run_rows(bump_at=0.20))
+    assert near["H_mid_error"] < 1e-12 and far["H_mid_error"] == pytest.approx(0.2)
+    assert em.THRESHOLD_BAND == 0.02
+
+
+def test_missing_thresholds_and_incomplete_runs_say_why_and_have_no_bound():
+    summary = {"status": "complete", "dW1_over_L": 0.30, "dW2_over_L": None,
+               "unresolved_thresholds": {"dW2_over_L": {"value": 0.5, "reason": "the strain reaches 0.03"}}}
+    e = em.row_errors(reference(), summary, run_rows())
+    assert "dW2_bound" not in e and "dW2 null: located at 0.5000 but unresolved" in e["reason"]
+    stopped = em.row_errors(reference(), {"status": "stopped", "message": "Newton failed", "dW1_over_L": 0.3,
+                                          "dW2_over_L": 0.45}, run_rows(upto=0.4))
+    assert not any(f"{q}_bound" in stopped for q in em.QUANTITIES)
+    assert "compared up to dW/L = 0.4000 only" in stopped["reason"] and "no bounds" in stopped["reason"]
+
+
+def test_table_is_resumable_by_key_and_hashes(tmp_path):
+    path = tmp_path / "map.csv"
+    table = em.Table(path)
+    row = {"scene": "dL0.5_W0.05_Lb1181", "model": "rod", "resolution": 50, "resolution_label": "M50",
+           "source_hash": "a", "reference_hash": "r", "dW1_bound": 0.01}
+    table.put(row)
+    table.put({**row, "model": "ribbon", "resolution_label": "M51"})
+    again = em.Table(path)
+    assert again.current(("rod", "M50", "dL0.5_W0.05_Lb1181"), "a", "r")
+    assert not again.current(("rod", "M50", "dL0.5_W0.05_Lb1181"), "b", "r")     # other sources: recompute
+    assert not again.current(("rod", "M50", "dL0.5_W0.05_Lb1181"), "a", "s")     # other reference: recompute
+    again.put({**row, "source_hash": "b", "dW1_bound": 0.02})                    # replaces, never duplicates
+    with open(path) as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 2 and [r["dW1_bound"] for r in rows if r["model"] == "rod"] == ["0.02"]
+    assert list(rows[0]) == list(em.COLUMNS)
+
+
+def _map_row(w, lb, model, label, wall, bound):
+    row = {c: "" for c in em.COLUMNS}
+    row.update(scene=f"dL0.5_W{w:.4g}_Lb{lb:.0f}", compression_ratio="0.5", width_ratio=repr(w), slenderness=repr(lb),
+               model=model, resolution=label[1:], resolution_label=label, wall_time_s=repr(wall))
+    for q in em.QUANTITIES:
+        row[f"{q}_bound"] = repr(bound)
+    return row
+
+
+def test_held_out_check_leaves_each_scene_out():
+    lb = 1181.1023622047244
+    rows = [_map_row(w, lb, "rod", "M100", 1.0, b) for w, b in ((0.05, 0.004), (1 / 12, 0.006), (1 / 6, 0.02))]
+    rows += [_map_row(w, lb, "plate", "R12", 100.0, b) for w, b in ((0.05, 0.003), (1 / 12, 0.012), (1 / 6, 0.008))]
+    out = {e["scene"]: e for e in em.held_out_check(rows, 0.01)}
+    edge, middle = out["dL0.5_W0.05_Lb1181"], out["dL0.5_W0.08333_Lb1181"]
+    assert not edge["held_out"] and "outside" in edge["why"]
+    assert middle["held_out"] and middle["basis"] == ["dL0.5_W0.05_Lb1181", "dL0.5_W0.1667_Lb1181"]
+    # rod predicted 0.02 (measured 0.006: holds), plate predicted 0.008 (measured 0.012: fails), 3 quantities each
+    assert (middle["compared"], middle["held"]) == (6, 3) and len(middle["violations"]) == 3
+    assert middle["choice"] == "plate R12" and middle["choice_holds"] is False
+    assert middle["choice_measured"] == pytest.approx(0.012)
+
+
+def test_cheapest_within_and_combined_error():
+    lb = 1181.1
+    rows = [_map_row(0.05, lb, "rod", "M100", 1.0, 0.02), _map_row(0.05, lb, "plate", "R12", 50.0, 0.009),
+            _map_row(0.05, lb, "fem", "N64", 40.0, 0.001)]
+    assert em.cheapest_within(rows, 0.01)["model"] == "fem"
+    assert em.cheapest_within(rows, 0.01, runnable_only=True)["model"] == "plate"
+    assert em.cheapest_within(rows, 0.0001) is None
+    rows[0]["dW2_bound"] = ""
+    assert em.combined_error(rows[0]) is None and em.combined_error(rows[1]) == pytest.approx(0.009)
+
+
+# ------------------------------------------------------------------------------ the committed map
+def committed_rows():
+    path = COMMITTED / em.CSV_NAME
+    if not path.exists():
+        pytest.skip("no committed error map")
+    return em.read_table(path)
+
+
+def test_committed_map_is_small_and_holds_no_run_folders():
+    committed_rows()
+    files = [p for p in COMMITTED.rglob("*") if p.is_file()]
+    assert {p.suffix for p in files} <= {".csv", ".md", ".png"}
+    assert sum(p.stat().st_size for p in files) < 2e6
+    assert all(p.stat().st_size < 300e3 for p in files if p.suffix == ".png")
+    assert len([p for p in files if p.suffix == ".png"]) <= 2
+
+
+def test_committed_map_covers_every_scene_with_a_reference():
+    rows = committed_rows()
+    scenes = {r["scene"] for r in rows}
+    expected = {s.name for s in em.reference_scenes() if s.reference is not None}
+    assert expected <= scenes, sorted(expected - scenes)
+    assert len(expected) == 12   # the ten benchmark scenes and the narrow strip at L/b = 300 and 100
+    for s in scenes:
+        models = {r["model"] for r in rows if r["scene"] == s}
+        assert {"rod", "plate", "fem"} <= models, (s, models)
+    for r in rows:   # a row without a bound says why
+        if any(r[f"{q}_bound"] == "" for q in em.QUANTITIES):
+            assert r["reason"], r
+
+
+def test_committed_map_held_out_check():
+    """Leave-one-scene-out: the committed map's scenes bracketed by the others are the interior
+    widths at each compression and the narrow strip at L/b = 300 (the README reports the figures)."""
+    rows = committed_rows()
+    entries = em.held_out_check(rows, 0.01)
+    held = [e for e in entries if e["held_out"]]
+    assert {e["scene"] for e in held} == {"dL0.5_W0.08333_Lb1181", "dL0.5_W0.1667_Lb1181", "dL0.5_W0.3333_Lb1181",
+                                          "dL0.25_W0.08333_Lb787", "dL0.25_W0.1667_Lb787", "dL0.25_W0.3333_Lb787",
+                                          "dL0.5_W0.05_Lb300"}
+    assert len(held) >= 3 and all(e["compared"] > 0 for e in held)

@@ -28,21 +28,35 @@ __all__ = ["simulate", "run_ribbon", "simulate_dynamic", "make_model", "Simulati
            "DynamicResult"]
 
 #: ribbon: M not a multiple of 4, see RibbonModel
-DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "plate-midedge": 2000, "ribbon": 101}
+#: Default resolution per model: rod and ribbons M nodes (the ribbons' M is not a multiple of 4, see
+#: ddg.models.ribbon), plates target triangles.
+DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "plate-midedge": 2000, "ribbon": 101, "ribbon-sano-wada": 101,
+                      "ribbon-trapeze": 101, "ribbon-wunderlich": 101}
+#: The models on the rod's centreline and frame (resolution = node count M).
+ROD_FAMILY = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-wunderlich")
 
 
 #: Stations along the centerline exported per recorded step (centerline.csv).
 CENTERLINE_STATIONS = 101
 
 
-def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None):
+def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None, zeta: float | None = None):
     """The model `name` of the strip at `resolution` (rod: nodes M; plate: target triangles).
+
+    zeta (m): the regularisation length of the ribbon (Eq. A.5) and of the Wunderlich ribbon's
+    ruling slope (ddg.energies.wunderlich); other models refuse it.
 
     mesh (plate only): a PlateMesh, the path of a mesh file meshio reads, or "gmsh" for an
     unstructured gmsh mesh with about `resolution` triangles; default the structured mesh.
     """
     cls = _model_class(name)
     resolution = check_resolution(name, resolution)
+    if zeta is not None:
+        if name not in ("ribbon", "ribbon-wunderlich"):
+            raise InputError(f"zeta applies to the models 'ribbon' and 'ribbon-wunderlich' only, not {name!r}")
+        if mesh is not None:
+            raise InputError(f"a mesh is used by the plate models only, not {name!r}")
+        return cls(strip, resolution, zeta=zeta)
     if mesh is None:
         return cls(strip, resolution)
     if name not in ("plate", "plate-midedge"):
@@ -81,7 +95,10 @@ def _model_class(name: str):
     from .models.ribbon import RibbonModel
     from .models.rod import RodModel
 
-    models = {"rod": RodModel, "plate": PlateModel, "plate-midedge": MidedgePlateModel, "ribbon": RibbonModel}
+    from .models.wide_ribbons import WIDE_RIBBONS
+
+    models = {"rod": RodModel, "plate": PlateModel, "plate-midedge": MidedgePlateModel, "ribbon": RibbonModel,
+              **WIDE_RIBBONS}
     return models[check_model_name(name)]
 
 
@@ -104,7 +121,7 @@ def check_resolution(model: str, resolution, strip: Strip | None = None, mesh=No
     check_model_name(model)
     if resolution is None:
         return DEFAULT_RESOLUTION[model]
-    if model in ("rod", "ribbon"):
+    if model in ROD_FAMILY:
         return check_integer("resolution (node count M)", resolution, MIN_NODES, MAX_NODES,
                              "M = 200 already resolves the thresholds to 1e-4 L")
     value = check_integer("resolution (target triangle count)", resolution, 16, MAX_TRIANGLES)
@@ -198,6 +215,7 @@ def simulate(
     tolerance: float | None = None,
     quantities=None,
     error_map=None,
+    zeta: float | None = None,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
@@ -225,6 +243,10 @@ def simulate(
     column), per-branch summary under the summary key `branches`.
     probe: a ddg.solve.probe.Probe told of every Newton solve of the path and every recorded
     step with its wall time (benchmarks, progress displays).
+    zeta (m): the regularisation length of model "ribbon" (Eq. A.5, default 1e4 L) and of
+    "ribbon-wunderlich"'s ruling slope (default the Sano-Wada value sqrt((1 - nu) / 60) W^2 / b);
+    summary keys zeta, zeta_over_L. The ribbons with width ("ribbon-sano-wada", "ribbon-trapeze",
+    "ribbon-wunderlich", ddg.models.wide_ribbons) run like the rod (resolution = nodes M).
     model="auto" with `tolerance` (units of L; `quantities` of dW1, dW2, H_mid, default all;
     `error_map` a CSV, default $DDG_ERROR_MAP or data/error_map/error_map.csv): the cheapest
     model and resolution the error map predicts within the tolerance on this scene, or the safe
@@ -249,6 +271,8 @@ def simulate(
     if branches is not None and not isinstance(branches, (bool, np.bool_)):
         raise InputError(f"branches = {branches!r} must be True, False or None")
     resolution = check_resolution(model, resolution, strip, mesh)
+    if zeta is not None and model not in ("ribbon", "ribbon-wunderlich"):
+        raise InputError(f"zeta applies to the models 'ribbon' and 'ribbon-wunderlich' only, not {model!r}")
     protocol.resolved_shear_ratio(strip)
     if out is not None:
         from .output.io import check_output_directory
@@ -263,12 +287,14 @@ def simulate(
     if dynamic_options is not None:
         raise InputError("dynamic_options apply to solver='dynamic' only")
     branches = (model not in ("plate", "plate-midedge")) if branches is None else bool(branches)
-    instance = make_model(model, strip, resolution, mesh)
+    instance = make_model(model, strip, resolution, mesh, zeta=zeta)
     if frames and out is None:
         raise InputError("frames=True needs an output directory (out)")
     options = _checked_options(options)
+    extra = {"zeta": instance.zeta, "zeta_over_L": instance.zeta / strip.length} if hasattr(instance, "zeta") \
+        else None
     return _static_run(model, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,
-                       frames=frames, probe=probe)
+                       frames=frames, probe=probe, summary_extra=extra)
 
 
 def _static_run(name, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,

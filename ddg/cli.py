@@ -26,15 +26,23 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(EXIT_BAD_INPUT)
 
 
+#: --model choices of simulate: the plates, the rod and the ribbons (ddg.api.DEFAULT_RESOLUTION).
+MODEL_CHOICES = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", "ribbon-trapeze",
+                 "ribbon-wunderlich")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m ddg", description="DDG solvers for pre-buckled strips under shear.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sim = sub.add_parser("simulate", help="compress by dL, then shear by dW; write path.csv and summary.json")
-    sim.add_argument("--model", default="rod", choices=("rod", "plate", "plate-midedge", "ribbon", "auto"),
+    sim.add_argument("--model", default="rod", choices=MODEL_CHOICES + ("auto",),
                      help="rod (DAR, default), plate (DEP on a triangle mesh), plate-midedge (mid-edge "
-                          "Kirchhoff plate with the material's Poisson ratio) or ribbon (Sadowsky, Eq. A.5)")
+                          "Kirchhoff plate with the material's Poisson ratio), ribbon (Sadowsky, Eq. A.5), "
+                          "ribbon-sano-wada (Eq. A.5 with zeta^2 = (1 - nu) W^4 / (60 b^2)), ribbon-trapeze "
+                          "(the rod plus the edges' stretching under twist) or ribbon-wunderlich (Eq. A.2)")
     sim.add_argument("--zeta", type=float, default=None,
-                     help="ribbon: regularisation length zeta of Eq. (A.5) in metres (default 1e4 L)")
+                     help="ribbon: regularisation length zeta of Eq. (A.5) in metres (default 1e4 L); "
+                          "ribbon-wunderlich: the same for its ruling slope (default the Sano-Wada value)")
     sim.add_argument("--ribbon-init", choices=("direct", "rod"), default=None,
                      help="ribbon: 'direct' from the flat strip (default) or 'rod': relax each rod equilibrium")
     sim.add_argument("--width-ratio", type=float, default=0.05, help="W/L (default 0.05)")
@@ -317,13 +325,14 @@ def cmd_simulate(args) -> int:
             raise InputError("--model ribbon runs the static solver only, without --mesh or --frames")
         result = run_ribbon(strip, protocol, args.ribbon_init or "direct", args.zeta, args.resolution, out=args.out,
                             options=options, thresholds=not args.no_thresholds, progress=not args.quiet)
-    elif args.zeta is not None or args.ribbon_init is not None:
-        raise InputError(f"--zeta and --ribbon-init apply to --model ribbon only, not {args.model!r}")
+    elif args.ribbon_init is not None or (args.zeta is not None and args.model != "ribbon-wunderlich"):
+        raise InputError(f"--zeta applies to --model ribbon and ribbon-wunderlich, --ribbon-init to --model "
+                         f"ribbon only, not {args.model!r}")
     else:
         result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
                           progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options,
                           mesh=args.mesh, frames=args.frames, thresholds=not args.no_thresholds,
-                          branches=args.branches)
+                          branches=args.branches, zeta=args.zeta)
     s = result.summary
     if not args.quiet:
         keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",

@@ -154,8 +154,16 @@ class RodModel(BandedModel):
                                     grad, band, gradient, hessian)
         if gradient:
             add_stencil_terms(x, m1, m2, first, second, 0, n, grad, band, hessian)
+        parts.update(self.coupled_terms(x, m1, m2, kappa_n, tau, grad, band, gradient, hessian))
         return self._evaluation({"stretching": float(stretching), **parts}, grad, band, gradient, hessian,
                                 frames=(t, d1, m_ref))
+
+    def coupled_terms(self, x, m1, m2, kappa_n, tau, grad, band, gradient: bool, hessian: bool) -> dict:
+        """Energies beyond the per-stencil densities (the ribbons with width: the trapeze term's
+        stretch-twist coupling, Wunderlich's pairs of stencils): adds their gradient and Hessian
+        into grad and band (ddg.energies.stencil_coupling) and returns their totals by part. The
+        rod has none."""
+        return {}
 
     def stencil_density(self, kappa_n: np.ndarray, kappa_g: np.ndarray, tau: np.ndarray):
         """Bending (Eq. 6b) and twisting (Eq. 6c) of the interior nodes as functions of the strains:

@@ -1,0 +1,121 @@
+"""One-dimensional ribbon models that carry the width (paper section 4.3 and Appendix A).
+
+All three live on the rod's centreline and frame (Eq. 1: the same DOFs, clamps, reference
+frames, outputs, continuation, stability, thresholds and branch tracing as the DAR); each adds to
+or replaces the rod's bending and twisting (Eqs. 6b, 6c) with a ribbon energy of its own module:
+
+- `ribbon-sano-wada` (SanoWadaRibbon): Eq. (A.5) with Sano and Wada's (2019) width-dependent
+  regularisation zeta^2 = (1 - nu) W^4 / (60 b^2) (ddg.energies.sadowsky). zeta / L =
+  sqrt((1 - nu) / 60) W^2 / (b L) interpolates between the Kirchhoff rod (zeta -> 0, the quartic
+  term cut off) and Sadowsky's developable ribbon (zeta -> infinity) through W^2 / (b L).
+- `ribbon-trapeze` (TrapezeRibbon): the rod (Eqs. 6a-c) plus the stretching of the edges under
+  twist (ddg.energies.trapeze): E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640 per unit length.
+  It keeps the rod's twist stiffness GJ, so it is exact for small W, and sees the width where
+  W^2 tau / b is of order one.
+- `ribbon-wunderlich` (WunderlichRibbon): Wunderlich's finite-width developable ribbon, Eq. (A.2),
+  regularised at inflection points as (A.5) is (ddg.energies.wunderlich); zeta defaults to the
+  Sano-Wada value, and its effect is measured (validation/ribbon_regularisation.py).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..energies.sadowsky import check_zeta
+from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_strain_blocks,
+                                         stencil_stretch)
+from ..energies.trapeze import trapeze_coefficients, trapeze_density
+from ..energies.wunderlich import wunderlich_pair_density
+from ..geometry.strip import Strip
+from .ribbon import RibbonModel
+from .rod import RodModel
+
+__all__ = ["SanoWadaRibbon", "TrapezeRibbon", "WunderlichRibbon", "sano_wada_zeta", "WIDE_RIBBONS"]
+
+#: Strain indices of rod_curvature's (kappa_n, kappa_g, tau) order used here.
+_KAPPA_N, _TAU = 0, 2
+
+
+def sano_wada_zeta(strip: Strip) -> float:
+    """zeta = sqrt((1 - nu) / 60) W^2 / b (m), Sano and Wada (2019), the paper's Eq. (A.5)."""
+    return math.sqrt((1.0 - strip.poisson_ratio) / 60.0) * strip.width**2 / strip.thickness
+
+
+class SanoWadaRibbon(RibbonModel):
+    """Eq. (A.5) with zeta from the strip: sqrt((1 - nu) / 60) W^2 / b (Sano and Wada 2019)."""
+
+    name = "ribbon-sano-wada"
+
+    def __init__(self, strip: Strip, nodes: int = 101):
+        super().__init__(strip, nodes, zeta=sano_wada_zeta(strip))
+
+
+class TrapezeRibbon(RodModel):
+    """The DAR plus the trapeze term (ddg.energies.trapeze): the edges' stretching under twist."""
+
+    name = "ribbon-trapeze"
+
+    def __init__(self, strip: Strip, nodes: int = 101):
+        super().__init__(strip, nodes)
+        self.trapeze_coefficients = trapeze_coefficients(strip.young_modulus, strip.thickness, strip.width)
+
+    def coupled_terms(self, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
+        eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
+        energy, first, second = trapeze_density(eps, tau, self.voronoi_lengths, *self.trapeze_coefficients)
+        if gradient:
+            grads, hessians = stencil_strain_blocks(x, m1, m2)
+            n = len(eps)
+            local_grads = np.stack([eps_grad, grads[:, _TAU]], axis=1)
+            local_hess = np.stack([eps_hess, hessians[:, _TAU]], axis=1)
+            add_local_terms(4 * np.arange(n), local_grads, local_hess, first, second, self.n_dof, grad, band,
+                            hessian)
+        return {"trapeze": float(energy.sum())}
+
+
+class WunderlichRibbon(RibbonModel):
+    """Eq. (A.2) regularised as (A.5): the Sadowsky ribbon (RibbonModel) with GJ from the strip,
+    each node's density times the mean ruling factor g(W eta') of its pairs of stencils."""
+
+    name = "ribbon-wunderlich"
+    bandwidth = 14  # a pair of stencils spans 15 DOFs
+
+    def __init__(self, strip: Strip, nodes: int = 101, zeta: float | None = None):
+        super().__init__(strip, nodes, zeta=check_zeta(sano_wada_zeta(strip) if zeta is None else zeta))
+        self.pair_lengths = self.rest_edge_lengths[1:-1]
+        self.largest_ruling_rate = 0.0  # max |W eta'| of the last evaluated state (2 is the pole)
+
+    def pair_terms(self, kappa_n, tau):
+        s = self.strip
+        return wunderlich_pair_density(kappa_n, tau, self.voronoi_lengths, self.pair_lengths, s.width,
+                                       s.bending_stiffness, s.twisting_stiffness, self.voronoi_lengths / self.zeta)
+
+    def coupled_terms(self, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
+        energy, first, second, v = self.pair_terms(kappa_n, tau)
+        self.largest_ruling_rate = float(np.max(np.abs(v))) if len(v) else 0.0
+        total = float(energy.sum()) if np.all(np.isfinite(energy)) else math.inf
+        if gradient and math.isfinite(total):
+            grads, hessians = stencil_strain_blocks(x, m1, m2)
+            pg, ph = pair_blocks(grads, hessians, (_KAPPA_N, _TAU))
+            add_local_terms(4 * np.arange(len(v)), pg, ph, first, second, self.n_dof, grad, band, hessian)
+        elif gradient:
+            grad[:] = np.nan
+        return {"wunderlich": total}
+
+    def resolution_indicators(self, q: np.ndarray) -> dict:
+        """The rod's indicators plus the largest |W eta'| (the ruling factor's pole is at 2)."""
+        out = super().resolution_indicators(q)
+        x = q[self.node_dofs]
+        t, _, m1, m2, m_ref = self.frames(q)
+        from ..energies.rod_curvature import material_curvatures
+        from ..energies.rod_twist import discrete_twist
+
+        kappa_n, _ = material_curvatures(x, m1, m2)
+        tau = discrete_twist(q[self.theta_dofs], m_ref)
+        v = self.pair_terms(kappa_n, tau)[3]
+        out["max_ruling_rate"] = float(np.max(np.abs(v))) if len(v) else 0.0
+        return out
+
+
+#: The models of this module by their --model names.
+WIDE_RIBBONS = {cls.name: cls for cls in (SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon)}

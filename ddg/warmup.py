@@ -3,7 +3,7 @@
     python -m ddg warmup
 
 runs each compiled kernel on a tiny model with every argument type the solvers use (energy only,
-gradient, gradient and Hessian; rod, ribbon, plate; the array interfaces used in analysis). numba
+gradient, gradient and Hessian; rod, ribbons, plate; the array interfaces used in analysis). numba
 stores the machine code next to the modules (`cache=True`, in `__pycache__`); later processes
 load it (~0.2 s for all kernels) instead of compiling (~30-60 s). scripts/setup.sh calls it.
 """
@@ -24,6 +24,7 @@ def compile_kernels() -> dict:
     from .models.plate import PlateModel
     from .models.ribbon import RibbonModel
     from .models.rod import RodModel
+    from .models.wide_ribbons import TrapezeRibbon, WunderlichRibbon
     from .solve.banded import SymmetricBanded
     from .solve.lanczos import lowest_eigenvalue
 
@@ -37,7 +38,8 @@ def compile_kernels() -> dict:
         timings[name] = round(time.perf_counter() - start, 3)
 
     def models():
-        for model in (RodModel(strip, 9), RibbonModel(strip, 9), PlateModel(strip, 40)):
+        for model in (RodModel(strip, 9), RibbonModel(strip, 9), TrapezeRibbon(strip, 9),
+                      WunderlichRibbon(strip, 9, zeta=0.01 * strip.length), PlateModel(strip, 40)):
             q = model.reset()
             q = q + 1e-3 * strip.length * rng.standard_normal(q.shape)
             model.commit(q)

@@ -33,7 +33,13 @@ BASE_RESOLUTION = 64
 #: Elements across W of the coarsest mesh: multiples of 8, so that 1.5 and 2.25 times them are
 #: even (the mesh must be symmetric); h_y = W/8 .. W/24 (at 64 along L: 0.4 to 1.3 times h_x,
 #: at least 8 across, 4 of them on either side of y = 0).
-BASE_ACROSS = {1 / 20: 8, 1 / 12: 8, 1 / 6: 8, 1 / 3: 16, 1 / 2: 24}
+BASE_ACROSS = {1 / 20: 8, 1 / 12: 8, 1 / 8: 8, 1 / 6: 8, 1 / 4: 16, 1 / 3: 16, 1 / 2: 24}
+#: Scenes beyond the paper's ten that the error map (validation/error_map.py, issue 17) needs as
+#: references, as (dL/L, W/L, L/b or None for the paper's strip): held out of the map's fitting set
+#: to check its predictions (W/L = 1/8 and 1/4 lie between the paper's widths), and other L/b.
+#: Run with --only NAME; the default run is the paper's ten.
+MAP_SCENES = ((1 / 2, 1 / 8, None), (1 / 4, 1 / 8, None), (1 / 2, 1 / 4, None), (1 / 2, 1 / 20, 300.0),
+              (1 / 2, 1 / 6, 300.0))
 #: dW1 and dW2 bisection brackets of the gold runs (units of L), a tenth of the smallest change
 #: between meshes of the earlier W/L = 1/6 study (dW2: 0.4336 to 0.4306 from 90 to 120 elements).
 GOLD_TOLERANCES = (1e-4, 1e-4)
@@ -55,8 +61,10 @@ def run_folder_name(along: int, across: int) -> str:
     return f"N{along}x{across}"
 
 
-def scene_name(compression_ratio: float, width_ratio: float) -> str:
-    return f"dL{compression_ratio:.4g}_W{width_ratio:.4g}"
+def scene_name(compression_ratio: float, width_ratio: float, slenderness: float | None = None) -> str:
+    """dL<dL/L>_W<W/L>, with _Lb<L/b> for a strip other than the paper's (e.g. dL0.5_W0.05_Lb300)."""
+    name = f"dL{compression_ratio:.4g}_W{width_ratio:.4g}"
+    return name if slenderness is None else f"{name}_Lb{slenderness:.4g}"
 
 
 def scenes() -> list[tuple[str, float, float]]:
@@ -64,6 +72,12 @@ def scenes() -> list[tuple[str, float, float]]:
     first = [(1 / 2, 1 / 6), (1 / 2, 1 / 20), (1 / 2, 1 / 2)]
     rest = [(c, w) for c in COMPRESSION_RATIOS for w in WIDTH_RATIOS if (c, w) not in first]
     return [(scene_name(c, w), c, w) for c, w in first + rest]
+
+
+def all_scenes() -> list[tuple[str, float, float, float | None]]:
+    """The paper's ten and MAP_SCENES as (name, dL/L, W/L, L/b or None)."""
+    return [(name, c, w, None) for name, c, w in scenes()] + \
+        [(scene_name(c, w, lb), c, w, lb) for c, w, lb in MAP_SCENES]
 
 
 def _read_summary(path: Path) -> dict | None:
@@ -81,7 +95,7 @@ def check_gold_inputs(args) -> list[tuple[str, float, float, list[tuple[int, int
 
     from .mesh import checked_spec
 
-    known = [name for name, _, _ in scenes()]
+    known = [name for name, _, _, _ in all_scenes()]
     only = args.only or None
     if only:
         unknown = [name for name in dict.fromkeys(only) if name not in known]
@@ -92,14 +106,15 @@ def check_gold_inputs(args) -> list[tuple[str, float, float, list[tuple[int, int
                            "meshes per scene (3 for Richardson extrapolation with an observed order)")
     base = BASE_RESOLUTION if args.resolution is None else args.resolution
     selected = []
-    for name, dL, W in scenes():
-        if only and name not in only:
+    paper = {name for name, _, _ in scenes()}
+    for name, dL, W, slenderness in all_scenes():
+        if (only and name not in only) or (not only and name not in paper):
             continue
         checked_spec(base, W, None, "--resolution")  # the base count's own bounds first
         meshes = mesh_sequence(W, int(base), levels)
         for along, across in meshes:
             checked_spec(along, W, across, f"--resolution (mesh {along} x {across} of the study)")
-        selected.append((name, dL, W, meshes))
+        selected.append((name, dL, W, slenderness, meshes))
     check_output_directory(args.out, "--out")
     return selected
 
@@ -127,12 +142,12 @@ def run_gold(args) -> int:
     options = ContinuationOptions(dw1_tolerance=GOLD_TOLERANCES[0], dw2_tolerance=GOLD_TOLERANCES[1])
     status = 0
     try:
-        for name, dL, W, meshes in selected:
+        for name, dL, W, slenderness, meshes in selected:
             for along, across in meshes:
                 target = out / name / run_folder_name(along, across)
                 if _finished(_read_summary(target / "summary.json"), along, across):
                     continue
-                strip = Strip.from_ratios(W, dL)
+                strip = Strip.from_ratios(W, dL, slenderness)
                 t0 = time.perf_counter()
                 result = simulate(strip, LoadingProtocol(dL), along, out=target, across=across, fields=False,
                                   options=options, progress=False)
@@ -213,7 +228,7 @@ def write_index(out: Path) -> None:
     """OUT/index.json: every scene with its study (richardson.json) or its single run (the layout
     before the studies), then OUT/README.md."""
     index = {}
-    for name, dL, W in scenes():
+    for name, dL, W, slenderness in all_scenes():
         folder = out / name
         study = _read_summary(folder / "richardson.json")
         finest = finest_run(folder)
@@ -221,7 +236,8 @@ def write_index(out: Path) -> None:
         if s is None:
             continue
         scene, mesh = s.get("scene") or {}, s.get("mesh") or {}
-        entry = {"compression_ratio": dL, "width_ratio": W, "converged": bool(s.get("converged")),
+        entry = {"compression_ratio": dL, "width_ratio": W, "slenderness": slenderness,
+                 "converged": bool(s.get("converged")),
                  "status": s.get("status"), "message": s.get("message", ""),
                  "finest_run": str(finest.relative_to(out)), "resolution": scene.get("resolution"),
                  "triangles": mesh.get("triangles"), "n_dof": s.get("n_dof"), "wall_time_s": s.get("wall_time_s"),

@@ -100,3 +100,28 @@ def test_a_scene_study_from_stored_runs(tmp_path):
     assert finest_run(scene).name == "N90x18"
     (scene / "summary.json").write_text("{}")  # a single run of the layout before the studies
     assert finest_run(scene) == scene
+
+
+def test_the_error_map_scenes_are_named_by_their_strip_and_run_only_when_asked():
+    """MAP_SCENES (issue 17's held-out and other-L/b references) are named dL<..>_W<..>[_Lb<..>],
+    each width has a mesh sequence with exact 1.5 ratios, and the default gold run is the
+    paper's ten scenes: a map scene runs only when named with --only."""
+    from types import SimpleNamespace
+
+    from fem_reference.gold import MAP_SCENES, all_scenes, check_gold_inputs, mesh_sequence, scenes
+
+    names = [name for name, *_ in all_scenes()]
+    assert len(names) == len(set(names)) == 10 + len(MAP_SCENES)
+    assert "dL0.5_W0.125" in names and "dL0.5_W0.05_Lb300" in names
+    for _, _, width, _ in all_scenes():
+        meshes = mesh_sequence(width)
+        assert all(abs(b[0] / a[0] - 1.5) < 1e-12 and abs(b[1] / a[1] - 1.5) < 1e-12
+                   for a, b in zip(meshes, meshes[1:]))
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as out:
+        default = check_gold_inputs(SimpleNamespace(only=None, levels=None, resolution=None, out=out))
+        assert [s[0] for s in default] == [name for name, _, _ in scenes()]
+        chosen = check_gold_inputs(SimpleNamespace(only=["dL0.5_W0.05_Lb300"], levels=None, resolution=None,
+                                                   out=out))
+        assert [(s[0], s[3]) for s in chosen] == [("dL0.5_W0.05_Lb300", 300.0)]

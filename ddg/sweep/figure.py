@@ -21,8 +21,8 @@ PHASE_COLOURS = {"U": "#dbe9f6", "US": "#fde6cf", "S": "#dff2de"}
 
 
 def gold_thresholds(data: Path = DATA) -> list[dict]:
-    """The FEM gold scenes (data/fem_gold/index.json) that converged: dL/L, W/L, dW1/L, dW2/L,
-    the mesh (elements along L) and the errors `dW1_error`, `dW2_error` estimated by the
+    """The FEM gold scenes of the paper's strip (data/fem_gold/index.json) that converged: dL/L,
+    W/L, dW1/L, dW2/L, the mesh (elements along L) and the errors `dW1_error`, `dW2_error` estimated by the
     Richardson extrapolation of data/fem_convergence/<scene>[_full]/thresholds.csv at that mesh
     (None where no study exists: no error bar)."""
     index = Path(data) / "fem_gold" / "index.json"
@@ -30,8 +30,8 @@ def gold_thresholds(data: Path = DATA) -> list[dict]:
         return []
     out = []
     for scene, entry in sorted(json.loads(index.read_text()).items()):
-        if not entry.get("converged"):
-            continue
+        if not entry.get("converged") or entry.get("slenderness") is not None:
+            continue  # unfinished, or a strip other than the paper's (the error map's scenes)
         errors = _convergence_errors(Path(data) / "fem_convergence", scene, entry.get("resolution"))
         out.append({"scene": scene, "dL_over_L": entry["compression_ratio"], "W_over_L": entry["width_ratio"],
                     "resolution": entry.get("resolution"), "dW1_over_L": entry.get("dW1_over_L"),

@@ -613,3 +613,48 @@ def test_snapshots_show_the_plate_states_from_its_frames(tmp_path):
 
     nodes = meshio.read(states[0][2]).points / strip.length
     assert np.allclose([[float(r[k]) for k in ("x_over_L", "y_over_L", "z_over_L")] for r in rows], nodes)
+
+
+def _map_row(compression, width, model, label, bounds, wall, slenderness=None, dW1=0.3, dW2=0.5):
+    """One error-map row (validation/error_map.py's columns used by the report) with the given
+    dW1/dW2/H_mid error-plus-bar bounds."""
+    from ddg import Strip
+
+    lb = slenderness or Strip.from_ratios(width, compression).slenderness
+    row = {"compression_ratio": str(compression), "width_ratio": str(width), "slenderness": str(lb),
+           "model": model, "resolution": label[1:], "resolution_label": label, "dW1": str(dW1), "dW2": str(dW2),
+           "ref_dW1": "0.31", "ref_dW2": "0.49", "wall_time_s": str(wall), "reason": ""}
+    for q, b in zip(("dW1", "dW2", "H_mid"), bounds):
+        row[f"{q}_bound"] = "" if b is None else str(b)
+        row[f"{q}_error"] = "" if b is None else str(b / 2)
+    return row
+
+
+def test_the_ribbon_and_error_map_sections_render_from_the_map():
+    """The '1D models with width' and 'which model is enough' sections: every row of the tables
+    built from an error map (validation.report_data.wide_ribbon_table, enough_table) is rendered,
+    and the counting sentence is computed from the table (1 of 2 scenes within 0.01 on all three,
+    2 of 2 on dW1)."""
+    pytest.importorskip("jinja2")
+    from validation.report import render_html, render_markdown
+    from validation.report_data import ENOUGH_COLUMNS, WIDE_COLUMNS, Table, enough_table, wide_ribbon_table
+
+    rows = [_map_row(0.5, 0.05, "rod", "M100", (0.005, 0.05, 0.09), 0.8),
+            _map_row(0.5, 0.05, "ribbon-trapeze", "M101", (0.04, 0.02, 0.05), 1.5),
+            _map_row(0.5, 0.05, "fem", "N64x8", (0.004, 0.003, 0.004), 80.0),
+            _map_row(0.25, 1 / 3, "plate", "R16", (0.009, 0.008, 0.0097), 62.0),
+            _map_row(0.25, 1 / 3, "plate", "R24", (0.007, 0.003, 0.005), 120.0)]
+    wide, enough = wide_ribbon_table(rows), enough_table(rows)
+    assert [(r["model"], r["resolution"]) for r in wide] == [("rod", "M100"), ("ribbon-trapeze", "M101"),
+                                                              ("plate", "R24")]
+    assert [(r["on_dW1"], r["on_all_three"]) for r in enough] == [("rod M100", "none"), ("plate R16", "plate R16")]
+    data = _hand_made_report()
+    data.tables["wide_ribbons"] = Table("wide_ribbons", WIDE_COLUMNS, wide, csv=True)
+    data.tables["enough"] = Table("enough", ENOUGH_COLUMNS, enough, csv=True)
+    md, page = render_markdown(data), render_html(data)
+    for table in (data.tables["wide_ribbons"], data.tables["enough"]):
+        for row in table.rows:
+            assert _md_row(row, table.shown_columns) in md.splitlines(), (table.name, row)
+            assert _html_row(row, table.shown_columns) in page, (table.name, row)
+    assert "## 1D models with width" in md and "## Which model is enough (error map)" in md
+    assert "1 of 2 scenes have a model within 0.01 L on all three; 2 on dW1 alone." in md

@@ -14,7 +14,9 @@ import numpy as np
 
 from .report_data import FigureData, fraction
 
-COLORS = {"rod": "tab:blue", "plate": "tab:orange", "ribbon": "tab:green", "fem": "black"}
+COLORS = {"rod": "tab:blue", "plate": "tab:orange", "ribbon": "tab:green", "fem": "black",
+          "ribbon-sano-wada": "tab:olive", "ribbon-trapeze": "tab:purple", "ribbon-wunderlich": "tab:brown",
+          "fem (extrapolated)": "black"}
 STABILITY_CATEGORIES = ["ok", "ok (mesh unresolved near dW_max)", "missed pitchfork", "dW1 unresolved by the mesh",
                         "rod width error", "Newton failure"]
 STABILITY_COLORS = ["tab:green", "yellowgreen", "tab:red", "tab:orange", "tab:purple", "black"]
@@ -135,6 +137,28 @@ def thresholds(rows: list[dict], compressions: list[float], dW_max: dict, paper:
         ax.set_xlabel("W/L")
         ax.set_ylabel("threshold dW/L")
         ax.legend(fontsize=6)
+    fig.tight_layout()
+    return fig
+
+
+def wide_ribbons(rows: list[dict], compressions: list[float]):
+    """dW1/L (circles) and dW2/L (squares) against W/L per model, one panel per compression."""
+    plt = _pyplot()
+    fig, axes = plt.subplots(1, len(compressions), figsize=(4.8 * len(compressions), 3.8), squeeze=False)
+    for ax, compression in zip(axes.flat, compressions):
+        for (model,), sel in _groups([r for r in rows if r["compression_ratio"] == compression], "model"):
+            sel = sorted(sel, key=lambda r: r["width_ratio"])
+            style = "-" if model.startswith("fem") else ":"
+            for key, marker in (("dW1_over_L", "o"), ("dW2_over_L", "s")):
+                pts = [(r["width_ratio"], r[key]) for r in sel if r[key] is not None]
+                if pts:
+                    ax.plot(*zip(*pts), marker + style, color=COLORS.get(model, "gray"), ms=4, lw=1,
+                            label=f"{model} {key[:3]}")
+        ax.set_xscale("log")
+        ax.set_title(f"dL/L = {fraction(compression)}", fontsize=9)
+        ax.set_xlabel("W/L (log scale)")
+        ax.set_ylabel("threshold dW/L")
+        ax.legend(fontsize=5.5, ncol=2)
     fig.tight_layout()
     return fig
 
@@ -267,7 +291,7 @@ def _rendered_snapshots(panels: list[dict], widths: list[float], cols: int):
 
 DRAW = {"elastica": elastica, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
         "convergence": convergence, "poisson": poisson, "speed_accuracy": speed_accuracy,
-        "stability_map": stability_map, "snapshots": snapshots}
+        "stability_map": stability_map, "snapshots": snapshots, "wide_ribbons": wide_ribbons}
 
 
 def draw(data: FigureData):

@@ -21,7 +21,7 @@ from ddg.geometry.strip import shear_limit
 from . import claims as C
 from .estimates import Study, load_study, single_run_study, study_from_runs
 from .reference import FEM_FINE, PAPER_DROPS_QUARTER, GoldCurve, load_dep_material, load_gold, paper_value
-from .studies import COMPRESSIONS, SNAPSHOT_SCENES, SPEED_SCENE, Profile
+from .studies import COMPRESSIONS, SNAPSHOT_SCENES, SPEED_SCENE, WIDTHS_GOLD, Profile
 from .verdicts import (PAPER_DISAGREEMENT, ClaimsVerdict, MaterialCheck, MeshTrend, PaperReading, paper_disagreements,
                        unusual_outcomes)
 
@@ -567,6 +567,112 @@ def benchmark_table() -> Table:
     return Table("benchmark", columns, rows, csv=True, shown=shown)
 
 
+#: The 1D models of the "1D models with width" section and the resolution shown for each (the
+#: ribbons' default M = 101, the rod's paper M = 100); the plate at its study's finest mesh.
+WIDE_MODELS = (("rod", "M100"), ("ribbon", "M101"), ("ribbon-sano-wada", "M101"), ("ribbon-trapeze", "M101"),
+               ("ribbon-wunderlich", "M101"))
+#: Tolerance (units of L) of the "cheapest model within" table: the issue's 1 %.
+ENOUGH_TOLERANCE = 0.01
+WIDE_COLUMNS = ["compression_ratio", "width_ratio", "model", "resolution", "dW1_over_L", "dW2_over_L",
+                "ref_dW1", "ref_dW2", "dW1_error", "dW2_error", "H_mid_error", "wall_time_s", "reason"]
+ENOUGH_COLUMNS = ["compression_ratio", "width_ratio", "slenderness", "on_dW1", "on_dW1_bound", "on_all_three",
+                  "on_all_three_bound", "wall_time_s"]
+
+
+def error_map_rows(path: Path | None = None) -> list[dict]:
+    """The committed error map (data/error_map/error_map.csv, validation/error_map.py), [] if absent."""
+    from .error_map import read_table
+    from .reference import ROOT
+
+    path = Path(path) if path is not None else ROOT / "data" / "error_map" / "error_map.csv"
+    return read_table(path) if path.exists() else []
+
+
+def _paper_scene(row: dict) -> tuple[float, float] | None:
+    """(dL/L, W/L) of a map row on one of the paper's ten scenes at the paper's strip, else None."""
+    from ddg.geometry.strip import Strip
+
+    for compression in COMPRESSIONS:
+        for width in WIDTHS_GOLD:
+            if abs(float(row["compression_ratio"]) - compression) < 1e-9 and \
+                    abs(float(row["width_ratio"]) - width) < 1e-6 * width:
+                lb = Strip.from_ratios(width, compression).slenderness
+                if abs(float(row["slenderness"]) - lb) < 1e-6 * lb:
+                    return compression, width
+    return None
+
+
+def _num(value):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def wide_ribbon_table(rows: list[dict]) -> list[dict]:
+    """Per paper scene: dW1/L, dW2/L and the errors against the FEM study (error map rows) of the
+    rod, the ribbons (WIDE_MODELS) and the plate on its study's finest mesh."""
+    out = []
+    scenes = sorted({s for s in (_paper_scene(r) for r in rows) if s is not None}, key=lambda s: (-s[0], s[1]))
+    for compression, width in scenes:
+        mine = [r for r in rows if _paper_scene(r) == (compression, width)]
+        picks = [r for model, label in WIDE_MODELS for r in mine
+                 if r["model"] == model and r["resolution_label"] == label]
+        plates = [r for r in mine if r["model"] == "plate"]
+        if plates:
+            picks.append(max(plates, key=lambda r: int(float(r["resolution"]))))
+        for r in picks:
+            out.append({"compression_ratio": compression, "width_ratio": width, "model": r["model"],
+                        "resolution": r["resolution_label"], "dW1_over_L": _num(r["dW1"]),
+                        "dW2_over_L": _num(r["dW2"]), "ref_dW1": _num(r["ref_dW1"]), "ref_dW2": _num(r["ref_dW2"]),
+                        "dW1_error": _num(r["dW1_error"]), "dW2_error": _num(r["dW2_error"]),
+                        "H_mid_error": _num(r["H_mid_error"]), "wall_time_s": _num(r["wall_time_s"]),
+                        "reason": r.get("reason", "")})
+    return out
+
+
+def enough_table(rows: list[dict], tolerance: float = ENOUGH_TOLERANCE) -> list[dict]:
+    """Per map scene: the cheapest model ddg runs (the FEM left out) whose error plus the
+    reference's error bar is within `tolerance` on dW1 alone and on dW1, dW2 and H_mid together
+    (validation.error_map.cheapest_within), with its bound and wall time; "none" where none is."""
+    from .error_map import cheapest_within, combined_error
+
+    out = []
+    keys = sorted({(float(r["compression_ratio"]), float(r["width_ratio"]), float(r["slenderness"])) for r in rows},
+                  key=lambda k: (-k[0], k[1], k[2]))
+    for compression, width, slenderness in keys:
+        mine = [r for r in rows if (float(r["compression_ratio"]), float(r["width_ratio"]),
+                                    float(r["slenderness"])) == (compression, width, slenderness)]
+        dw1 = cheapest_within(mine, tolerance, ("dW1",), runnable_only=True)
+        all3 = cheapest_within(mine, tolerance, runnable_only=True)
+        out.append({"compression_ratio": compression, "width_ratio": width, "slenderness": round(slenderness),
+                    "on_dW1": f"{dw1['model']} {dw1['resolution_label']}" if dw1 else "none",
+                    "on_dW1_bound": _num(dw1["dW1_bound"]) if dw1 else None,
+                    "on_all_three": f"{all3['model']} {all3['resolution_label']}" if all3 else "none",
+                    "on_all_three_bound": combined_error(all3) if all3 else None,
+                    "wall_time_s": _num(all3["wall_time_s"]) if all3 else None})
+    return out
+
+
+def wide_ribbon_figure(table: list[dict]) -> FigureData:
+    """dW1/L and dW2/L against W/L of the rod, the ribbons and the plate, with the FEM study's
+    extrapolated values (the error map's reference)."""
+    rows = [[r["model"], r["compression_ratio"], r["width_ratio"], r["dW1_over_L"], r["dW2_over_L"]] for r in table]
+    seen = set()
+    for r in table:
+        if (r["compression_ratio"], r["width_ratio"]) not in seen:
+            seen.add((r["compression_ratio"], r["width_ratio"]))
+            rows.append(["fem (extrapolated)", r["compression_ratio"], r["width_ratio"], r["ref_dW1"], r["ref_dW2"]])
+    return FigureData(
+        "ribbons_vs_width", "wide_ribbons",
+        "1D models with width: dW1/L (circles) and dW2/L (squares) against W/L of the rod (M = 100), the ribbons "
+        "(M = 101) and the plate (finest mesh of its study) beside the FEM study's extrapolated values; a missing "
+        "marker is a threshold the model does not reach (reason in the table).",
+        ["model", "compression_ratio", "width_ratio", "dW1_over_L", "dW2_over_L"], rows,
+        {"compressions": list(COMPRESSIONS)})
+
+
 def _missing(**inputs) -> str:
     """What a claim lacks: the names of the inputs that are None, joined ('' if none is)."""
     return ", ".join(f"no {name}" for name, value in inputs.items() if value is None)
@@ -678,6 +784,12 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
                                shown=[c for c in smap_columns if c != "message"]),
         "benchmark": benchmark_table(),
     }
+    map_rows = error_map_rows()
+    if map_rows:
+        wide = wide_ribbon_table(map_rows)
+        tables["wide_ribbons"] = Table("wide_ribbons", WIDE_COLUMNS, wide, csv=True)
+        tables["enough"] = Table("enough", ENOUGH_COLUMNS, enough_table(map_rows), csv=True)
+        figures.append(wide_ribbon_figure(wide))
     provenance = Provenance(profile.name, len(results), len(set(all_specs)), len(all_specs),
                             sorted(golds), sorted(scene for scene in scenes if scene not in golds))
     timings = Timings(sum(float(r.summary.get("wall_time_s") or 0.0) for r in results.values()))

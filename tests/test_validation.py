@@ -634,7 +634,7 @@ def test_the_ribbon_and_error_map_sections_render_from_the_map():
     """The '1D models with width' and 'which model is enough' sections: every row of the tables
     built from an error map (validation.report_data.wide_ribbon_table, enough_table) is rendered,
     and the counting sentence is computed from the table (1 of 2 scenes within 0.01 on all three,
-    2 of 2 on dW1)."""
+    2 on dW1 alone)."""
     pytest.importorskip("jinja2")
     from validation.report import render_html, render_markdown
     from validation.report_data import ENOUGH_COLUMNS, WIDE_COLUMNS, Table, enough_table, wide_ribbon_table

@@ -6,7 +6,8 @@ The error map (data/error_map/error_map.csv, written by `python -m validation.er
 row per (model, resolution, scene): for each quantity q of dW1/L, dW2/L and H_mid/L its error
 against the converged FEM reference of that scene and the reference's own error bar, and their sum
 `q_bound` (for H_mid the largest pointwise sum over the shear path, 0.02 L away from the
-reference's thresholds), with the run's wall time.
+reference's thresholds), with the run's wall time. Rows of held-out scenes (column role =
+"held-out") are never used to predict: they exist to check the prediction.
 
 Prediction rule (conservative, never an extrapolation). A scene is (dL/L, W/L, L/b). Its basis is
 the map scenes of the same dL/L that bracket it: in W/L the nearest map width at or below it and
@@ -130,6 +131,12 @@ def load_map(path) -> list[dict]:
         if missing:
             raise InputError(f"error map {str(path)!r} lacks the columns {', '.join(sorted(missing))}")
         return parse_rows(reader)
+
+
+def fitting(rows) -> list[dict]:
+    """The rows the prediction uses: all but those of held-out scenes (column role = "held-out":
+    scenes kept out of the fitting set to check the prediction, validation/error_map.py)."""
+    return [r for r in rows if r.get("role") != "held-out"]
 
 
 def parse_rows(raw_rows) -> list[dict]:
@@ -322,6 +329,7 @@ def choose(width_ratio, compression_ratio, slenderness=None, tolerance=None, qua
         where = str(file.relative_to(ROOT)) if file.is_relative_to(ROOT) else str(file)
     else:
         where = str(path) if path is not None else "(rows given)"
+    rows = fitting(rows)
     names = "/".join(quantities)
     basis, outside = basis_scenes(rows, scene) if rows else ([], f"the error map {where} has no rows")
     if not basis:

@@ -148,3 +148,30 @@ def test_committed_map_held_out_check():
                                           "dL0.25_W0.08333_Lb787", "dL0.25_W0.1667_Lb787", "dL0.25_W0.3333_Lb787",
                                           "dL0.5_W0.05_Lb300"}
     assert len(held) >= 3 and all(e["compared"] > 0 for e in held)
+
+
+def test_held_out_scenes_are_predicted_from_the_fitting_set_only():
+    """A scene with role held-out is never used to predict (ddg.advise.fitting) and is checked against
+    the fitting scenes that bracket it."""
+    lb = 1181.1023622047244
+    rows = [_map_row(w, lb, "rod", "M100", 1.0, b) for w, b in ((0.05, 0.004), (1 / 6, 0.02))]
+    held = _map_row(0.125, lb, "rod", "M100", 1.0, 0.03)
+    held["role"] = "held-out"
+    out = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05)}
+    e = out["dL0.5_W0.125_Lb1181"]
+    assert e["role"] == "held-out" and e["held_out"] and (e["compared"], e["held"]) == (3, 0)
+    assert e["choice"] == "rod M100" and e["choice_holds"] is True
+    # the held-out row does not change what the fitting scenes predict for each other
+    from ddg.advise import choose, parse_rows
+    assert choose(0.1, 0.5, None, 0.05, rows=parse_rows(rows + [held])).predicted_errors["dW1"] == 0.02
+
+
+def test_committed_map_held_out_scenes_are_those_with_a_finished_study():
+    """The held-out scenes of fem_reference.gold.MAP_SCENES (W/L = 1/8, 1/4) are in the map once their
+    FEM study is finished; when the map was committed none was (their runs were in progress)."""
+    rows = committed_rows()
+    held = {r["scene"] for r in rows if r.get("role") == "held-out"}
+    finished = {s.name for s in em.reference_scenes() if s.role == "held-out" and s.reference is not None}
+    assert held <= finished
+    entries = [e for e in em.held_out_check(rows, 0.01) if e["role"] == "held-out"]
+    assert len(entries) == len(held)

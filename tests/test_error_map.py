@@ -127,7 +127,7 @@ def test_committed_map_is_small_and_holds_no_run_folders():
 def test_committed_map_covers_every_scene_with_a_reference():
     rows = committed_rows()
     scenes = {r["scene"] for r in rows}
-    expected = {s.name for s in em.reference_scenes() if s.reference is not None}
+    expected = {s.name for s in em.reference_scenes() if s.reference is not None and s.role == "fit"}
     assert expected <= scenes, sorted(expected - scenes)
     assert len(expected) == 12   # the ten benchmark scenes and the narrow strip at L/b = 300 and 100
     for s in scenes:

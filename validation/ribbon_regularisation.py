@@ -12,7 +12,8 @@ ribbons (ribbon-sano-wada, ribbon with zeta = 1e4 L) and the rod beside them, an
                             dW2/L, the last dW/L reached, the largest |W eta'| on the path, message
     OUT/README.md           the same as a table, with the generator command
 
-Resumable row by row: a row whose key (scene, model, factor) is in the CSV is not rerun.
+Resumable row by row: a row whose key (scene, model, factor) is in the CSV is not rerun. Each run
+has TIMEOUT_S of wall time; one that needs more is reported with status "timeout" and what it reached.
 """
 from __future__ import annotations
 
@@ -25,6 +26,9 @@ from pathlib import Path
 SCENES = ((0.5, 1 / 20), (0.5, 1 / 6), (0.25, 1 / 20), (0.25, 1 / 6))
 FACTORS = (1 / 16, 1 / 4, 1.0, 4.0)
 NODES = 101
+#: Wall-time limit per run (s): past it the run is stopped and its converged part reported
+#: (status "timeout"); Wunderlich runs that creep along the ruling factor's barrier can take hours.
+TIMEOUT_S = 300
 COLUMNS = ("compression_ratio", "width_ratio", "model", "zeta_over_zeta_sw", "zeta_over_L", "status",
            "dW1_over_L", "dW2_over_L", "last_dW_over_L", "max_ruling_rate", "message")
 
@@ -42,15 +46,38 @@ def key(dL, W, model, factor) -> tuple:
     return (f"{dL:.4g}", f"{W:.4g}", model, "" if factor is None else f"{factor:.4g}")
 
 
-def run_case(dL: float, W: float, model: str, factor: float | None) -> dict:
+class _TimeUp(KeyboardInterrupt):
+    """Raised by the alarm: ddg.simulate treats it as an interruption and keeps every converged step."""
+
+
+def _time_up(signum, frame):
+    raise _TimeUp()
+
+
+def run_case(dL: float, W: float, model: str, factor: float | None, timeout: int = TIMEOUT_S) -> dict:
+    import signal
+
     import ddg
     from ddg.models.wide_ribbons import sano_wada_zeta
 
     strip = ddg.Strip.from_ratios(W, dL)
     zeta = None if model != "ribbon-wunderlich" else factor * sano_wada_zeta(strip)
-    result = ddg.simulate(strip, ddg.LoadingProtocol(dL), model=model, resolution=NODES, branches=False,
-                          zeta=zeta)
+    previous = signal.signal(signal.SIGALRM, _time_up)
+    signal.alarm(timeout)
+    try:
+        result = ddg.simulate(strip, ddg.LoadingProtocol(dL), model=model, resolution=NODES, branches=False,
+                              zeta=zeta)
+        timed_out = False
+    except _TimeUp as stop:
+        result, timed_out = getattr(stop, "result", None), True
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+    if result is None:
+        raise RuntimeError(f"{model} at dL/L = {dL:g}, W/L = {W:.4g}: no result after the time limit")
     s = result.summary
+    if timed_out:
+        s = {**s, "status": "timeout", "message": f"stopped after {timeout} s: {s.get('message', '')}"}
     rates = []
     if model == "ribbon-wunderlich":
         rates = [result.model.resolution_indicators(result.final_state.q)["max_ruling_rate"]]

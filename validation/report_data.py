@@ -21,11 +21,11 @@ from ddg.geometry.strip import shear_limit
 from . import claims as C
 from .estimates import Study, load_study, single_run_study, study_from_runs
 from .reference import FEM_FINE, PAPER_DROPS_QUARTER, GoldCurve, load_dep_material, load_gold, paper_value
-from .studies import COMPRESSIONS, SNAPSHOT_SCENES, SPEED_SCENE, WIDTHS_GOLD, Profile
+from .studies import COMPRESSIONS, SNAPSHOT_SCENES, SPEED_SCENE, WIDE_RIBBONS, WIDTHS_GOLD, Profile
 from .verdicts import (PAPER_DISAGREEMENT, ClaimsVerdict, MaterialCheck, MeshTrend, PaperReading, paper_disagreements,
                        unusual_outcomes)
 
-MODELS = ("rod", "plate", "ribbon")
+MODELS = ("rod", "plate", "ribbon") + WIDE_RIBBONS
 CLAIM_COLUMNS = ["claim", "statement", "bound", "measured", "holds", "reason", "difference", "combined_error_bar",
                  "in_error_bars", "needs"]
 THRESHOLD_COLUMNS = ["model", "compression_ratio", "width_ratio", "dW1_over_L", "paper_dW1", "dW1_rel_diff_vs_paper",

@@ -13,7 +13,9 @@ COMPRESSIONS = (1 / 2, 1 / 4)
 WIDTHS_PHASE_DIAGRAM = (1 / 20, 1 / 16, 1 / 12, 1 / 10, 1 / 8, 1 / 6, 1 / 5, 1 / 4, 1 / 3, 1 / 2.5, 1 / 2)
 #: (dL/L, W/L) of the 3D snapshots (paper Fig. 1): a narrow and a wide plate; their plate runs keep frames
 SNAPSHOT_SCENES = ((1 / 2, 1 / 20), (1 / 2, 1 / 6))
-SPEED_SCENE = (1 / 2, 1 / 6)  # (dL/L, W/L) of the speed-accuracy chart (the FEM gold scene of the cross-model test)
+SPEED_SCENE = (1 / 2, 1 / 6)
+#: The 1D models with width (ddg.models.wide_ribbons), run like the rod at M = 101 on `wide_ribbon_scenes`.
+WIDE_RIBBONS = ("ribbon-sano-wada", "ribbon-trapeze", "ribbon-wunderlich")  # (dL/L, W/L) of the speed-accuracy chart (the FEM gold scene of the cross-model test)
 
 
 @dataclass
@@ -28,6 +30,7 @@ class Profile:
     speed: dict[str, tuple[int, ...]]                 # model -> resolutions on SPEED_SCENE
     poisson: tuple[float, ...] = (0.0, 0.25, 0.49)
     shear_steps: int = 120
+    wide_ribbon_scenes: list[tuple[float, float]] = field(default_factory=list)
     extra: dict = field(default_factory=dict)
 
 
@@ -38,13 +41,14 @@ def quick() -> Profile:
         shear_curves=[(c, w) for c in COMPRESSIONS for w in WIDTHS_PAPER],
         # the plate at its default 2000 triangles: at 1000 its W/L = 1/6 strip never reaches S
         # (US with H_mid/L ~ 0.03-0.06 to dW_max), against S from dW/L = 0.443 at 2000
-        models={"rod": 100, "plate": 2000, "ribbon": 101},
+        models={"rod": 100, "plate": 2000, "ribbon": 101, **{m: 101 for m in WIDE_RIBBONS}},
         plate_scenes=[(1 / 2, 1 / 20), (1 / 2, 1 / 6)],
         ribbon_scenes=[(1 / 2, 1 / 20)],
         phase_widths=(),
         convergence={"rod": (50, 100, 200)},
         speed={"rod": (50, 100, 200), "plate": (500, 1000, 2000)},
         shear_steps=60,
+        wide_ribbon_scenes=[(1 / 2, 1 / 20), (1 / 2, 1 / 6)],
     )
 
 
@@ -53,7 +57,7 @@ def full() -> Profile:
     return Profile(
         name="full",
         shear_curves=[(c, w) for c in COMPRESSIONS for w in WIDTHS_GOLD],
-        models={"rod": 100, "plate": 2000, "ribbon": 101},
+        models={"rod": 100, "plate": 2000, "ribbon": 101, **{m: 101 for m in WIDE_RIBBONS}},
         plate_scenes=[(c, w) for c in COMPRESSIONS for w in WIDTHS_GOLD],
         ribbon_scenes=[(c, 1 / 20) for c in COMPRESSIONS],
         phase_widths=WIDTHS_PHASE_DIAGRAM,
@@ -61,6 +65,7 @@ def full() -> Profile:
         speed={"rod": (25, 50, 100, 200, 400), "plate": (250, 500, 1000, 2000, 4000, 6000),
                "ribbon": (51, 101, 201)},
         shear_steps=120,
+        wide_ribbon_scenes=[(c, w) for c in COMPRESSIONS for w in WIDTHS_GOLD],
     )
 
 
@@ -101,6 +106,8 @@ def specs(profile: Profile) -> dict[str, list[RunSpec]]:
             out["shear"].append(shear_spec("plate", c, w, profile.models["plate"], profile))
         if "ribbon" in profile.models and (c, w) in profile.ribbon_scenes:
             out["shear"].append(shear_spec("ribbon", c, w, profile.models["ribbon"], profile))
+        if (c, w) in profile.wide_ribbon_scenes:
+            out["shear"] += [shear_spec(m, c, w, profile.models[m], profile) for m in WIDE_RIBBONS]
     for c in COMPRESSIONS:  # Fig. 8: the plate and the rod (cheap) at every width
         for w in profile.phase_widths:
             out["phase"].append(shear_spec("plate", c, w, profile.models["plate"], profile))

@@ -18,7 +18,7 @@ from ..geometry.strip import InputError
 
 PACKAGE = Path(__file__).resolve().parent.parent  # ddg/
 
-MODELS = ("rod", "plate", "plate-midedge", "ribbon")
+MODELS = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-wunderlich")
 
 #: Modules of this package that schedule runs and present results but take no part in computing
 #: one: editing them keeps every cached run (a new module is hashed until it is listed here).
@@ -34,7 +34,7 @@ class RunSpec:
     """One run: the model on the scene of `ddg.Strip.from_ratios(width_ratio, compression_ratio,
     slenderness, poisson_ratio=...)`, compressed then sheared to `shear_ratio` (None: dW_max/L)."""
 
-    model: str                     # rod | plate | ribbon
+    model: str                     # one of MODELS
     width_ratio: float
     compression_ratio: float
     resolution: int | None = None  # None: the model's default

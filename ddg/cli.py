@@ -333,12 +333,25 @@ def cmd_simulate(args) -> int:
                           progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options,
                           mesh=args.mesh, frames=args.frames, thresholds=not args.no_thresholds,
                           branches=args.branches, zeta=args.zeta)
+    return _finish_simulate(args, result)
+
+
+#: summary.json keys `simulate` prints (and, with --model auto, the `auto` block).
+PRINTED_KEYS = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
+                "newton_iterations", "wall_time_s", "converged", "message")
+
+
+def _finish_simulate(args, result, auto: bool = False) -> int:
+    """Print the run's summary (unless --quiet), its warnings and, if it did not complete, the
+    error line; the exit code (0 or EXIT_NOT_CONVERGED)."""
     s = result.summary
     if not args.quiet:
-        keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
-                "newton_iterations", "wall_time_s", "converged", "message")
+        keys = PRINTED_KEYS + (("auto",) if auto else ())
         print(json.dumps({k: s.get(k) for k in keys}, indent=2))
         print(f"wrote {Path(args.out) / 'path.csv'} and {Path(args.out) / 'summary.json'}")
+    if auto:
+        block = s.get("auto") or {}
+        sys.stderr.write(f"auto: {block.get('chosen_model')} {block.get('resolution_label')}: {block.get('reason')}\n")
     for warning in s.get("warnings") or ():
         sys.stderr.write(f"warning: {warning}\n")
     if not result.converged:
@@ -404,20 +417,7 @@ def cmd_simulate_auto(args, strip: Strip, protocol: LoadingProtocol) -> int:
     result = simulate(strip, protocol, "auto", out=args.out, options=options, progress=not args.quiet,
                       thresholds=not args.no_thresholds, branches=args.branches, tolerance=tolerance,
                       quantities=quantities, error_map=args.error_map)
-    s = result.summary
-    if not args.quiet:
-        keys = ("model", "H_mid_over_L_compressed", "dW_max_over_L", "dW1_over_L", "dW2_over_L", "n_dof",
-                "newton_iterations", "wall_time_s", "converged", "message", "auto")
-        print(json.dumps({k: s.get(k) for k in keys}, indent=2))
-        print(f"wrote {Path(args.out) / 'path.csv'} and {Path(args.out) / 'summary.json'}")
-    auto = s.get("auto") or {}
-    sys.stderr.write(f"auto: {auto.get('chosen_model')} {auto.get('resolution_label')}: {auto.get('reason')}\n")
-    for warning in s.get("warnings") or ():
-        sys.stderr.write(f"warning: {warning}\n")
-    if not result.converged:
-        sys.stderr.write(f"error: run did not complete: {s['message']}; converged part kept in {args.out}\n")
-        return EXIT_NOT_CONVERGED
-    return 0
+    return _finish_simulate(args, result, auto=True)
 
 
 def main(argv=None) -> int:

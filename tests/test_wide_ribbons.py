@@ -235,3 +235,34 @@ def test_coupled_terms_alone_match_finite_differences(kind, seed):
     assert getattr(model, "largest_ruling_rate", 0.0) < 1.9
     gradient_error, hessian_error = coupled_part_errors(model, base, q, rod_dof_scale(model))
     assert gradient_error < 2e-7 and hessian_error < 2e-7, (gradient_error, hessian_error)
+
+
+def test_a_wunderlich_state_near_the_pole_says_so():
+    """stop_note names the barrier when |W eta'| is within 10 % of the pole, and is silent on a
+    state well inside it (the driver adds the note to a stopped run's message and warnings)."""
+    strip = ddg.Strip(length=0.1, width=0.02, thickness=1e-4, young_modulus=1e9)
+    model = WunderlichRibbon(strip, 15, zeta=10.0)
+    q = model.buckled_guess(0.02)
+    model.commit(q)
+    assert model.stop_note(q) is None
+    base = q[model.theta_dofs[7]]
+    for kink in np.linspace(0.0, 0.5, 201):
+        q[model.theta_dofs[7]] = base + kink
+        rate = model.resolution_indicators(q)["max_ruling_rate"]
+        if 1.85 < rate < 2.0:
+            break
+    assert 1.85 < rate < 2.0, rate
+    note = model.stop_note(q)
+    assert note is not None and "pole of Wunderlich's ruling factor" in note and f"{rate:.3f}" in note
+
+
+@pytest.mark.slow
+def test_a_wunderlich_path_stopped_at_the_barrier_is_reported_so():
+    """W/L = 1/20, dL/L = 1/2, zeta = 4 zeta_SW: the path stops at dW/L 0.7255 with |W eta'| =
+    1.95 (measured); the message and the warnings say the fold may be the log barrier."""
+    strip = ddg.Strip.from_ratios(1 / 20, 0.5)
+    result = ddg.simulate(strip, ddg.LoadingProtocol(0.5), model="ribbon-wunderlich", resolution=NODES,
+                          branches=False, zeta=4 * sano_wada_zeta(strip))
+    assert result.summary["status"] == "stopped"
+    assert "log barrier" in result.summary["message"]
+    assert any("pole of Wunderlich's ruling factor" in w for w in result.summary["warnings"])

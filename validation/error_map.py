@@ -50,7 +50,7 @@ import numpy as np
 
 from ddg.advise import QUANTITIES, basis_scenes, choose, fitting, map_scenes, parse_rows, predictions, scene_name
 from ddg.advise import Scene as MapScene
-from ddg.output.io import StoredRun, atomic_write_text, finished_run_summary, write_table_csv
+from ddg.output.io import StoredRun, atomic_write_text, finished_run_summary, finite_float, write_table_csv
 
 from .claims import THRESHOLD_BAND
 from .estimates import MIDEDGE_GOLD, PLATE_GOLD, Study, away_from, load_study, study_from_runs
@@ -409,14 +409,7 @@ def build(out: Path, only=None, models=None, quiet: bool = False, timeout: int =
 
 
 # ------------------------------------------------------------------------------------ analysis
-def _f(value) -> float | None:
-    if value is None or value == "":
-        return None
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        return None
-    return v if math.isfinite(v) else None
+_f = finite_float
 
 
 def within(row: dict, tolerance: float, quantities=QUANTITIES) -> bool:

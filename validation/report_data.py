@@ -17,6 +17,7 @@ import numpy as np
 
 from ddg.analysis.analytic import clamped_elastica_midpoint_height
 from ddg.geometry.strip import shear_limit
+from ddg.output.io import finite_float
 
 from . import claims as C
 from .estimates import Study, load_study, single_run_study, study_from_runs
@@ -602,12 +603,6 @@ def _paper_scene(row: dict) -> tuple[float, float] | None:
     return None
 
 
-def _num(value):
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        return None
-    return v if math.isfinite(v) else None
 
 
 def wide_ribbon_table(rows: list[dict]) -> list[dict]:
@@ -624,10 +619,10 @@ def wide_ribbon_table(rows: list[dict]) -> list[dict]:
             picks.append(max(plates, key=lambda r: int(float(r["resolution"]))))
         for r in picks:
             out.append({"compression_ratio": compression, "width_ratio": width, "model": r["model"],
-                        "resolution": r["resolution_label"], "dW1_over_L": _num(r["dW1"]),
-                        "dW2_over_L": _num(r["dW2"]), "ref_dW1": _num(r["ref_dW1"]), "ref_dW2": _num(r["ref_dW2"]),
-                        "dW1_error": _num(r["dW1_error"]), "dW2_error": _num(r["dW2_error"]),
-                        "H_mid_error": _num(r["H_mid_error"]), "wall_time_s": _num(r["wall_time_s"]),
+                        "resolution": r["resolution_label"], "dW1_over_L": finite_float(r["dW1"]),
+                        "dW2_over_L": finite_float(r["dW2"]), "ref_dW1": finite_float(r["ref_dW1"]), "ref_dW2": finite_float(r["ref_dW2"]),
+                        "dW1_error": finite_float(r["dW1_error"]), "dW2_error": finite_float(r["dW2_error"]),
+                        "H_mid_error": finite_float(r["H_mid_error"]), "wall_time_s": finite_float(r["wall_time_s"]),
                         "reason": r.get("reason", "")})
     return out
 
@@ -648,10 +643,10 @@ def enough_table(rows: list[dict], tolerance: float = ENOUGH_TOLERANCE) -> list[
         all3 = cheapest_within(mine, tolerance, runnable_only=True)
         out.append({"compression_ratio": compression, "width_ratio": width, "slenderness": round(slenderness),
                     "on_dW1": f"{dw1['model']} {dw1['resolution_label']}" if dw1 else "none",
-                    "on_dW1_bound": _num(dw1["dW1_bound"]) if dw1 else None,
+                    "on_dW1_bound": finite_float(dw1["dW1_bound"]) if dw1 else None,
                     "on_all_three": f"{all3['model']} {all3['resolution_label']}" if all3 else "none",
                     "on_all_three_bound": combined_error(all3) if all3 else None,
-                    "wall_time_s": _num(all3["wall_time_s"]) if all3 else None})
+                    "wall_time_s": finite_float(all3["wall_time_s"]) if all3 else None})
     return out
 
 

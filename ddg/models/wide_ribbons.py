@@ -26,7 +26,7 @@ from ..energies.sadowsky import check_zeta
 from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_strain_blocks,
                                          stencil_stretch)
 from ..energies.trapeze import trapeze_coefficients, trapeze_density
-from ..energies.wunderlich import wunderlich_pair_density
+from ..energies.wunderlich import POLE, wunderlich_pair_density
 from ..geometry.strip import Strip
 from .ribbon import RibbonModel
 from .rod import RodModel
@@ -116,6 +116,21 @@ class WunderlichRibbon(RibbonModel):
         out["max_ruling_rate"] = float(np.max(np.abs(v))) if len(v) else 0.0
         return out
 
+
+    def stop_note(self, q: np.ndarray) -> str | None:
+        """Why a stopped path may have stopped: |W eta'| within NEAR_POLE of the ruling factor's
+        pole at 2 (the log barrier of Eq. A.2), where a fold found by the continuation may be the
+        barrier rather than a limit point of the ribbon; None otherwise."""
+        rate = self.resolution_indicators(q)["max_ruling_rate"]
+        if rate < NEAR_POLE * POLE:
+            return None
+        return (f"the last converged state has |W eta'| = {rate:.3f}, near the pole of Wunderlich's ruling factor "
+                f"at 2 (Eq. A.2): the fold where the path stopped may be that log barrier, not a limit point of the "
+                f"ribbon (zeta = {self.zeta / self.strip.length:.3g} L regularises eta)")
+
+
+#: A stopped Wunderlich path whose largest |W eta'| is above NEAR_POLE * 2 is said to stop at the barrier.
+NEAR_POLE = 0.9
 
 #: The models of this module by their --model names.
 WIDE_RIBBONS = {cls.name: cls for cls in (SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon)}

@@ -64,6 +64,17 @@ def read_json_object(path: Path) -> dict | None:
     return value if isinstance(value, dict) else None
 
 
+def finite_float(value) -> float | None:
+    """value (a number or a CSV cell) as a finite float; None for '', None, text or inf/nan."""
+    if value is None or value == "":
+        return None
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        return None
+    return number if math.isfinite(number) else None
+
+
 def finished_run_summary(folder: Path) -> dict | None:
     """The summary.json of a run folder whose run ended (status "complete" or "stopped"), else
     None: the test by which resumable studies keep a finished run and redo any other."""

@@ -167,6 +167,19 @@ def follow(run: Run) -> PathOutcome:
     return out
 
 
+def _model_stop_note(run: Run, out) -> None:
+    """A stopped path's model may know why it could not go on beyond what Newton saw (the
+    Wunderlich ribbon at its ruling factor's pole): its `stop_note(q)` at the last converged state
+    is added to the message and the warnings."""
+    note = getattr(getattr(run.stepper, "model", None), "stop_note", None)
+    if out.stopped is None or out.state is None or note is None:
+        return
+    text = note(out.state.q)
+    if text:
+        run.summary["message"] = f"{run.summary['message']}; {text}"
+        run.summary["warnings"].append(text)
+
+
 def execute(run: Run) -> SimulationResult:
     """follow(run), then the steps after the path, the summary, the run's files; returns the
     result, or re-raises an interrupt or an error after writing what was computed."""
@@ -191,6 +204,7 @@ def execute(run: Run) -> SimulationResult:
     run.stepper.summarise(run.summary)
     finish_summary(run.summary, out.rows, path_complete=out.complete, stopped=out.stopped,
                    interrupted=out.interrupted, stage=out.stage, error=out.error)
+    _model_stop_note(run, out)
     result = (run.make_result(out) if run.make_result is not None
               else SimulationResult(out.rows, run.summary, out.state, run.stepper.model))
     if run.folder is not None:

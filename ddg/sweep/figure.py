@@ -13,6 +13,7 @@ import textwrap
 from pathlib import Path
 
 from ..geometry.strip import shear_limit
+from ..output.io import finite_float
 
 #: The repository's data folder (gold data and its convergence studies); absent in an installed wheel.
 DATA = Path(__file__).resolve().parents[2] / "data"
@@ -53,7 +54,7 @@ def _convergence_errors(root: Path, scene: str, resolution) -> dict:
                 if row.get("resolution") != str(resolution):
                     continue
                 for key in ("dW1_error", "dW2_error"):
-                    value = _number(row.get(key))
+                    value = finite_float(row.get(key))
                     if key not in found and value is not None:
                         found[key] = value
     return found
@@ -216,9 +217,3 @@ def _fmt(value) -> str:
     return "?" if value is None else f"{value:.2g}"
 
 
-def _number(text):
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        return None
-    return value if math.isfinite(value) else None

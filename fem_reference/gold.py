@@ -270,7 +270,9 @@ convergence.md. A scene folder with a single run at its top level is from before
 (60 elements, dW2 to 1e-3 L); the report's H_mid figures still draw it, while the claims and the
 benchmark use the studies' converged values (validation/estimates.py). Runs of other meshes in a
 scene folder are kept as evidence (W/L = 1/6: 40 x 8, 60 x 12, 90 x 18, not asymptotic:
-convergence_40_60_90.md) and are not part of its study.
+convergence_40_60_90.md) and are not part of its study. Below the paper's ten, the error map's
+scenes (fem_reference.gold.MAP_SCENES, `--only NAME`, names with _Lb<L/b> for another strip) are
+listed as far as they have been run; the error map (validation/error_map.py) uses one from two meshes.
 
 Error bars (fem_reference.convergence.estimate): with three meshes whose differences shrink
 monotonically and an observed order p in [1, 4], the value is the Richardson extrapolation and

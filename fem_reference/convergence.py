@@ -93,12 +93,14 @@ def estimate(values, resolutions, tolerance: float = 0.0) -> dict | None:
     return out
 
 
-def study_estimates(runs, resolutions, band: float = 0.02) -> dict:
-    """estimate() of dW1, dW2 (with the runs' bisection tolerances), H_mid after compression and
-    H_mid(dW) on the common recorded grid of the runs that reached the shear stage; the curve's
-    largest error bar away from the thresholds (|dW - dW_i| > band)."""
+def study_estimates(runs, resolutions, band: float = 0.02, default_tolerances: dict | None = None) -> dict:
+    """estimate() of dW1, dW2 (with the runs' bisection tolerances: summary.json's
+    threshold_tolerances_over_L, else `default_tolerances` for runs stored before that key), H_mid
+    after compression and H_mid(dW) on the common recorded grid of the runs that reached the shear
+    stage; the curve's largest error bar away from the thresholds (|dW - dW_i| > band)."""
     def tolerance(key):
-        return max(float((r.summary.get("threshold_tolerances_over_L") or {}).get(key) or 0.0) for r in runs)
+        return max(float((r.summary.get("threshold_tolerances_over_L") or default_tolerances or {}).get(key) or 0.0)
+                   for r in runs)
 
     dw1 = estimate([r.summary["dW1_over_L"] for r in runs], resolutions, 0.5 * tolerance("dW1"))
     dw2 = estimate([r.summary["dW2_over_L"] for r in runs], resolutions, tolerance("dW2"))

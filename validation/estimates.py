@@ -191,11 +191,13 @@ def study_from_runs(model: str, runs, resolutions, unit: str = "elements") -> St
     runs at M = 50/100/200), extrapolated as the stored studies are; None with fewer than 2 runs."""
     from fem_reference.convergence import study_estimates
 
+    from .plate_gold import DDG_TOLERANCES
+
     pairs = sorted(zip(resolutions, runs), key=lambda p: p[0])
     if len(pairs) < 2:
         return None
     resolutions, runs = [n for n, _ in pairs], [r for _, r in pairs]
-    estimates = study_estimates(runs, resolutions)
+    estimates = study_estimates(runs, resolutions, default_tolerances=DDG_TOLERANCES)
     scene = runs[-1].summary["scene"]
     prefix = "M" if model in ("rod", "ribbon") else "N"   # M: the rod's nodes, as its CLI names it
     meshes = [MeshResult(f"{prefix}{n}", int(n), unit, r.summary.get("dW1_over_L"), r.summary.get("dW2_over_L"))

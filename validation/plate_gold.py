@@ -24,11 +24,15 @@ import time
 from pathlib import Path
 
 from ddg.output.io import atomic_write_text, finished_run_summary, read_json_object
+from ddg.solve.thresholds import THRESHOLD_TOLERANCES
 
 #: Rows of triangles across W on the coarsest mesh (a multiple of 8: 1.5 and 2.25 times it stay even).
 BASE_ROWS = {1 / 20: 8, 1 / 12: 8, 1 / 8: 8, 1 / 6: 8, 1 / 4: 16, 1 / 3: 16, 1 / 2: 16}
 REFINEMENT = 1.5
 LEVELS = 3
+#: The DDG's threshold bisection brackets (ddg.solve.thresholds), for runs stored before their
+#: summary.json recorded them: each study's error bars include them.
+DDG_TOLERANCES = dict(zip(("dW1", "dW2"), THRESHOLD_TOLERANCES))
 
 
 def rows_sequence(width_ratio: float, levels: int = LEVELS) -> list[int]:
@@ -88,7 +92,7 @@ def write_scene_study(folder: Path, sequence: list[int], model: str = "plate") -
         return None
     runs = [StoredRun(str(path)) for _, path in found]
     resolutions = [rows for rows, _ in found]
-    estimates = study_estimates(runs, resolutions)
+    estimates = study_estimates(runs, resolutions, default_tolerances=DDG_TOLERANCES)
     scene = runs[-1].summary["scene"]
     study = {"model": model, "mesh": MODELS[model],
              "scene": {k: scene[k] for k in ("width_ratio", "compression_ratio", "slenderness")},

@@ -16,6 +16,7 @@ import scipy
 from ..analysis.observables import resolved_up_to
 from ..geometry.strip import LoadingProtocol, Strip
 from ..output.interrupts import signal_name_of
+from ..solve.thresholds import THRESHOLD_TOLERANCES
 from ..output.io import (STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED, write_centerline_csv, write_path_csv,
                          write_summary_json)
 from ..version import __version__
@@ -93,6 +94,7 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
         "dW2_over_L": None,
         "dW2_S_stable_over_L": None,
         "threshold_wall_time_s": None,
+        "threshold_tolerances_over_L": {"dW1": THRESHOLD_TOLERANCES[0], "dW2": THRESHOLD_TOLERANCES[1]},
         "threshold_newton_iterations": None,
         "branches": None,
         "branches_wall_time_s": None,

@@ -134,9 +134,14 @@ def locate_phase_change(model, options, start: Snapshot, first_after: float, is_
     return hi
 
 
+#: Bisection brackets (units of L) of dW1 and dW2 (dW2_S_stable uses dW2's); summary.json records
+#: them as threshold_tolerances_over_L, and the mesh studies add them to the error bars.
+THRESHOLD_TOLERANCES = (1e-4, 1e-3)
+
+
 def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | None,
                      last_us: Snapshot | None, first_s: Snapshot | None,
-                     tolerances: tuple[float, float] = (1e-4, 1e-3)) -> dict:
+                     tolerances: tuple[float, float] = THRESHOLD_TOLERANCES) -> dict:
     """dW1, dW2 and dW2_S_stable (in metres; None where not bracketed by the recorded path), and
     "newton_iterations": those spent locating them."""
 

@@ -133,3 +133,14 @@ def test_plate_dW1_at_2000_triangles_within_0_005_of_the_fem(model):
     mesh = _mesh_near(study, 2000)
     assert abs(mesh.size - 2000) < 300 and mesh.dW1 is not None
     assert abs(mesh.dW1 - fem.dW1.value) <= 0.005, (mesh.label, mesh.dW1, fem.dW1.value)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "issue 16 item 3 target not met at W/L = 1/2, dL/L = 1/2: the paper's plate's dW1/L is 0.1298 on 1254 "
+    "triangles and 0.1334 on 2744 (the study meshes nearest 2000), 0.0268 and 0.0232 below the FEM's "
+    "0.1566 +- 0.0008"))
+def test_plate_dW1_near_2000_triangles_within_0_005_of_the_fem_at_one_half():
+    fem, study = _study("fem", 0.5, 1 / 2), _study("plate", 0.5, 1 / 2)
+    mesh = _mesh_near(study, 2000)
+    assert abs(mesh.size - 2000) < 800 and mesh.dW1 is not None
+    assert abs(mesh.dW1 - fem.dW1.value) <= 0.005, (mesh.label, mesh.dW1, fem.dW1.value)

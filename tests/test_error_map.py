@@ -129,7 +129,8 @@ def test_committed_map_covers_every_scene_with_a_reference():
     scenes = {r["scene"] for r in rows}
     expected = {s.name for s in em.reference_scenes() if s.reference is not None and s.role == "fit"}
     assert expected <= scenes, sorted(expected - scenes)
-    assert len(expected) == 12   # the ten benchmark scenes and the narrow strip at L/b = 300 and 100
+    # the ten benchmark scenes, W/L = 1/20 at L/b = 300 and 100, and W/L = 1/6 at L/b = 300
+    assert len(expected) == 13
     for s in scenes:
         models = {r["model"] for r in rows if r["scene"] == s}
         assert {"rod", "plate", "fem"} <= models, (s, models)
@@ -138,16 +139,36 @@ def test_committed_map_covers_every_scene_with_a_reference():
             assert r["reason"], r
 
 
+#: The held-out scenes of the committed map (fem_reference.gold.MAP_SCENES with a finished study).
+HELD_OUT = {"dL0.5_W0.125_Lb1181", "dL0.25_W0.125_Lb787", "dL0.5_W0.25_Lb1181"}
+
+
 def test_committed_map_held_out_check():
-    """Leave-one-scene-out: the committed map's scenes bracketed by the others are the interior
-    widths at each compression and the narrow strip at L/b = 300 (the README reports the figures)."""
+    """Leave-one-scene-out and held out: the committed map's scenes bracketed by the others are the
+    interior widths at each compression (W/L = 1/6 at dL/L = 1/2 now lies at the map's L/b edge:
+    the map has it at L/b = 300 and 1181), the narrow strip at L/b = 300 and the three held-out
+    scenes (the README reports the figures)."""
     rows = committed_rows()
     entries = em.held_out_check(rows, 0.01)
     held = [e for e in entries if e["held_out"]]
-    assert {e["scene"] for e in held} == {"dL0.5_W0.08333_Lb1181", "dL0.5_W0.1667_Lb1181", "dL0.5_W0.3333_Lb1181",
-                                          "dL0.25_W0.08333_Lb787", "dL0.25_W0.1667_Lb787", "dL0.25_W0.3333_Lb787",
-                                          "dL0.5_W0.05_Lb300"}
+    assert {e["scene"] for e in held} == {"dL0.5_W0.08333_Lb1181", "dL0.5_W0.3333_Lb1181", "dL0.25_W0.08333_Lb787",
+                                          "dL0.25_W0.1667_Lb787", "dL0.25_W0.3333_Lb787", "dL0.5_W0.05_Lb300"} | HELD_OUT
     assert len(held) >= 3 and all(e["compared"] > 0 for e in held)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "issue 17 acceptance not met: on the three held-out scenes 43 of 56 (candidate, quantity) predictions hold; "
+    "at dL/L = 1/2, W/L = 1/8 only 9 of 20 (plate R8 dW1 measured 0.0317 > predicted 0.0197, plate R12 dW2 "
+    "0.0147 > 0.0135, ribbon-trapeze M101 H_mid 0.1787 > 0.1410, the rod's dW2 by 2e-4 and the Sadowsky and "
+    "Sano-Wada H_mid by 0.02: errors not monotone in W/L, which the bracketing rule assumes); 20 of 20 at "
+    "dL/L = 1/4, W/L = 1/8; 14 of 16 at dL/L = 1/2, W/L = 1/4 (ribbon-trapeze H_mid)"))
+def test_the_predicted_error_holds_on_the_held_out_scenes():
+    """Every prediction made for a held-out scene from the fitting scenes bounds the error
+    measured there, on at least three held-out scenes (the rule was fixed before they existed)."""
+    entries = {e["scene"]: e for e in em.held_out_check(committed_rows(), 0.01)}
+    checked = [entries[name] for name in HELD_OUT if entries.get(name, {}).get("held_out")]
+    assert len(checked) >= 3
+    assert all(e["held"] == e["compared"] for e in checked), [(e["scene"], e["held"], e["compared"]) for e in checked]
 
 
 def test_held_out_scenes_are_predicted_from_the_fitting_set_only():

@@ -158,10 +158,10 @@ def test_committed_map_held_out_check():
 
 @pytest.mark.xfail(strict=True, reason=(
     "issue 17 acceptance not met: on the three held-out scenes 43 of 56 (candidate, quantity) predictions hold; "
-    "at dL/L = 1/2, W/L = 1/8 only 9 of 20 (plate R8 dW1 measured 0.0317 > predicted 0.0197, plate R12 dW2 "
-    "0.0147 > 0.0135, ribbon-trapeze M101 H_mid 0.1787 > 0.1410, the rod's dW2 by 2e-4 and the Sadowsky and "
-    "Sano-Wada H_mid by 0.02: errors not monotone in W/L, which the bracketing rule assumes); 20 of 20 at "
-    "dL/L = 1/4, W/L = 1/8; 14 of 16 at dL/L = 1/2, W/L = 1/4 (ribbon-trapeze H_mid)"))
+    "11 of 20 at dL/L = 1/2, W/L = 1/8 (plate R8 dW1 measured 0.0337 > predicted 0.0197, plate R12 dW1 0.0165 > "
+    "0.0154, ribbon-trapeze M101 H_mid 0.1787 > 0.1410, the Sadowsky and Sano-Wada H_mid by 0.02: errors not "
+    "monotone in W/L, which the bracketing rule assumes); 18 of 20 at dL/L = 1/4, W/L = 1/8 (plate R8 and R12 "
+    "dW1 by 1e-4 and 3e-4); 14 of 16 at dL/L = 1/2, W/L = 1/4 (ribbon-trapeze H_mid)"))
 def test_the_predicted_error_holds_on_the_held_out_scenes():
     """Every prediction made for a held-out scene from the fitting scenes bounds the error
     measured there, on at least three held-out scenes (the rule was fixed before they existed)."""

@@ -159,8 +159,9 @@ def rod_thresholds(out: Path, scenes=None, quiet: bool = True) -> dict:
     return stored
 
 
-def _fraction(x: float) -> str:
-    f = Fraction(x).limit_denominator(100)
+def fraction_label(x: float) -> str:
+    """A ratio as the nearest fraction with denominator <= 100 ("1/12", "1/4", "3")."""
+    f = Fraction(float(x)).limit_denominator(100)
     return f"{f.numerator}/{f.denominator}" if f.denominator != 1 else str(f.numerator)
 
 
@@ -180,7 +181,7 @@ def markdown_table(rows: list[dict]) -> str:
              "plate dW2/L | \\|diff\\|/combined | paper dW1/L | paper dW2/L | rod dW1/L | rod dW2/L |",
              "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        cells = [_fraction(r["compression_ratio"]), _fraction(r["width_ratio"]),
+        cells = [fraction_label(r["compression_ratio"]), fraction_label(r["width_ratio"]),
                  _number(r["width_squared_over_thickness_length"], "{:.1f}")]
         for key in THRESHOLDS:
             cells += [_with_bar(r[f"fem_{key}"], r[f"fem_{key}_error_bar"]),

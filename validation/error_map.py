@@ -43,7 +43,6 @@ import signal
 import sys
 import time
 from dataclasses import dataclass, field
-from fractions import Fraction
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +52,7 @@ from ddg.advise import Scene as MapScene
 from ddg.output.io import StoredRun, atomic_write_text, finished_run_summary, finite_float, write_table_csv
 
 from .claims import THRESHOLD_BAND
+from .benchmark import fraction_label
 from .estimates import MIDEDGE_GOLD, PLATE_GOLD, Study, away_from, load_study, study_from_runs
 from .reference import FEM_GOLD, ROOT, gold_name
 
@@ -492,11 +492,6 @@ def _is(row: dict, scene: MapScene) -> bool:
 
 
 # ------------------------------------------------------------------------------------ README, figures
-def _fraction(x: float) -> str:
-    f = Fraction(float(x)).limit_denominator(100)
-    return f"{f.numerator}/{f.denominator}" if f.denominator != 1 else str(f.numerator)
-
-
 def _num(value, spec="{:.4f}") -> str:
     v = _f(value)
     return "–" if v is None else spec.format(v)
@@ -542,7 +537,7 @@ def readme(rows: list[dict], held: dict, figures: list[str], missing: list[str])
         for n in names:
             mine = [r for r in rows if r["scene"] == n]
             f = first[n]
-            lines.append(f"| {_fraction(f['compression_ratio'])} | {_fraction(f['width_ratio'])} | "
+            lines.append(f"| {fraction_label(f['compression_ratio'])} | {fraction_label(f['width_ratio'])} | "
                          f"{float(f['slenderness']):.0f} | {float(f['width_squared_over_thickness_length']):.2f} | "
                          f"{_choice_cell(cheapest_within(mine, tol, ('dW1',), True))} | "
                          f"{_choice_cell(cheapest_within(mine, tol, QUANTITIES, True))} | "
@@ -643,7 +638,7 @@ def figures(rows: list[dict], out: Path, tolerance: float = 0.01) -> list[str]:
         ax.axhline(tolerance, color="0.5", lw=0.6, ls="--")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_title(f"W/L = {_fraction(w)}", fontsize=9)
+        ax.set_title(f"W/L = {fraction_label(w)}", fontsize=9)
         ax.set_xlabel("wall time (s)", fontsize=8)
         ax.tick_params(labelsize=7)
     axes[0, 0].set_ylabel("max over dW1, dW2, H_mid of\nerror + reference error bar (/L)", fontsize=8)
@@ -676,7 +671,7 @@ def figures(rows: list[dict], out: Path, tolerance: float = 0.01) -> list[str]:
             ax.set_yscale("log")
             ax.set_xlabel("W/L", fontsize=8)
             ax.set_ylabel("L/b", fontsize=8)
-            ax.set_title(f"dL/L = {_fraction(c)}: cheapest DDG model (else FEM mesh) within {tolerance:g} on {title}",
+            ax.set_title(f"dL/L = {fraction_label(c)}: cheapest DDG model (else FEM mesh) within {tolerance:g} on {title}",
                          fontsize=7)
             ax.tick_params(labelsize=7)
     fig.tight_layout()

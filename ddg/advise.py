@@ -16,10 +16,20 @@ L/b the nearest map L/b at or below and at or above (one where it equals one, to
 whose dL/L is not in the map, or whose W/L or L/b lies outside the map's range at a bracketing
 width, has no basis: it is outside the map. The predicted error of a candidate on quantity q is the
 largest q_bound over the basis scenes (error plus reference error bar: the worst of the bracketing
-scenes, so no interpolation can understate it); a candidate missing at one basis scene, or whose
+scenes), times the map's cross-validated margin (below); a candidate missing at one basis scene, or whose
 q is missing there (e.g. dW2 null), has no prediction for q and is not chosen. Its predicted cost
 is its largest wall time over the basis scenes. The choice is the candidate of least predicted
 cost whose predicted errors on the requested quantities are all at most the tolerance.
+
+Cross-validated margin (rule v2). Errors are not monotone in W/L: the plate on 8 rows is worse at
+W/L = 1/8 than at 1/12 and at 1/6, so the largest bound of the bracketing scenes (rule v1, margin 1)
+can understate an interior scene's error. The margin is measured on the fitting scenes alone,
+leave-one-out: each fitting scene bracketed by the others is predicted from them by rule v1, and the
+margin is the largest ratio measured bound / predicted bound over every (candidate, quantity) there,
+and at least 1 (cross_validated_margin). It is recomputed from whatever map is read, never from the
+held-out scenes; it was introduced after rule v1 had been checked on the first three held-out scenes
+(data/error_map/README.md gives both rules' figures on every held-out scene). On a scene of the map
+itself (one basis scene: nothing interpolated) the bound measured there is the prediction, margin 1.
 
 Safe choice: outside the map, or when no candidate is predicted within the tolerance, the paper's
 plate (Eq. 11) on a convergence pair, two exactly equilateral meshes refined by 1.5 (12 and 18
@@ -218,6 +228,11 @@ def basis_scenes(rows, scene: Scene) -> tuple[list[Scene], str]:
 
 
 # ------------------------------------------------------------------------------------ prediction
+def _at_scene(row, s: Scene) -> bool:
+    return (_same(float(row["compression_ratio"]), s.compression_ratio)
+            and _same(float(row["width_ratio"]), s.width_ratio) and _same(float(row["slenderness"]), s.slenderness))
+
+
 @dataclass
 class Prediction:
     """A candidate (model, resolution) on a scene: predicted error per quantity (None: no
@@ -238,13 +253,10 @@ class Prediction:
         return math.inf if any(v is None for v in values) else max(values)
 
 
-def predictions(rows, basis: list[Scene], runnable=None) -> list[Prediction]:
+def predictions(rows, basis: list[Scene], runnable=None, margin: float = 1.0) -> list[Prediction]:
     """Each candidate of the map (not NOT_RUN; among `runnable` model names if given) predicted
-    on the basis scenes, by the rule of the module docstring."""
-    def at(row, s):
-        return (_same(float(row["compression_ratio"]), s.compression_ratio)
-                and _same(float(row["width_ratio"]), s.width_ratio) and _same(float(row["slenderness"]), s.slenderness))
-
+    on the basis scenes, by the rule of the module docstring: the largest bound of the basis
+    scenes times `margin` (1: rule v1)."""
     candidates = {}
     for r in rows:
         if r["model"] in NOT_RUN or (runnable is not None and r["model"] not in runnable):
@@ -255,7 +267,7 @@ def predictions(rows, basis: list[Scene], runnable=None) -> list[Prediction]:
     out = []
     for (model, resolution, label), mine in candidates.items():
         errors, why, times = {}, {}, []
-        per_scene = [[r for r in mine if at(r, s)] for s in basis]
+        per_scene = [[r for r in mine if _at_scene(r, s)] for s in basis]
         for q in QUANTITIES:
             values = []
             for s, found in zip(basis, per_scene):
@@ -265,7 +277,7 @@ def predictions(rows, basis: list[Scene], runnable=None) -> list[Prediction]:
                               else f"{q} missing at {s.name}: {found[-1].get('reason') or 'no value'}")
                     break
                 values.append(bound)
-            errors[q] = max(values) if q not in why else None
+            errors[q] = max(values) * margin if q not in why else None
         for found in per_scene:
             if found and found[-1].get("wall_time_s") is not None:
                 times.append(found[-1]["wall_time_s"])
@@ -273,6 +285,64 @@ def predictions(rows, basis: list[Scene], runnable=None) -> list[Prediction]:
         out.append(Prediction(model, resolution, label, errors, wall, [s.name for s in basis], why))
     out.sort(key=lambda p: (math.inf if p.wall_time_s is None else p.wall_time_s, p.model, p.resolution))
     return out
+
+
+@dataclass(frozen=True)
+class Margin:
+    """The cross-validated margin (module docstring): its value, the (candidate, quantity)
+    comparisons it was measured on, and the one that set it."""
+    value: float
+    compared: int
+    scenes: int
+    worst: str
+
+    def text(self) -> str:
+        if self.worst.startswith("rule v1"):
+            return "margin 1 (rule v1)"
+        if self.worst.startswith("on a map scene"):
+            return "margin 1 (a scene of the map: its own measured bound)"
+        if not self.compared:
+            return "margin 1 (no fitting scene is bracketed by the others: nothing to cross-validate)"
+        return (f"margin {self.value:.3f}: the largest measured/predicted ratio of leave-one-out on {self.scenes} "
+                f"fitting scenes ({self.compared} comparisons; worst {self.worst})")
+
+
+#: Rule v1: the largest bound of the bracketing scenes as it is (no margin).
+RULE_V1_MARGIN = Margin(1.0, 0, 0, "rule v1: no margin")
+#: A scene of the map itself (its W/L and L/b both in the map): the bound measured there, no margin
+#: (nothing is interpolated).
+ON_A_MAP_SCENE = Margin(1.0, 0, 0, "on a map scene: measured there")
+
+
+def cross_validated_margin(rows, runnable=None) -> Margin:
+    """Leave-one-out on the fitting rows (held-out rows are dropped first): each scene bracketed
+    by the others is predicted from them with margin 1; the margin is the largest ratio measured
+    bound / predicted bound over every (candidate, quantity) compared, and at least 1."""
+    rows = fitting(rows)
+    worst, where, compared, scenes = 1.0, "none above 1", 0, 0
+    for scene in map_scenes(rows):
+        reduced = [r for r in rows if not _at_scene(r, scene)]
+        basis, _ = basis_scenes(reduced, scene)
+        if not basis:
+            continue
+        scenes += 1
+        mine = {}
+        for r in rows:
+            if _at_scene(r, scene):
+                mine[(r["model"], r["resolution_label"])] = r
+        for p in predictions(reduced, basis, runnable):
+            row = mine.get((p.model, p.label))
+            if row is None:
+                continue
+            for q in QUANTITIES:
+                predicted, measured = p.errors.get(q), row.get(f"{q}_bound")
+                if predicted is None or measured is None or not predicted > 0:
+                    continue
+                compared += 1
+                if measured / predicted > worst:
+                    worst = measured / predicted
+                    where = f"{p.model} {p.label} {q} at {scene.name}: {measured:.4f} against {predicted:.4f}"
+    return Margin(worst, compared, scenes, where)
 
 
 @dataclass
@@ -293,6 +363,7 @@ class Choice:
     wall_time_s: float | None = None
     cost_basis: str = ""
     candidates: list = field(default_factory=list, repr=False)
+    margin: Margin | None = None
 
     def auto_block(self) -> dict:
         return {"chosen_model": self.model, "resolution": self.resolution, "resolution_label": self.label,
@@ -300,6 +371,8 @@ class Choice:
                 "basis_scenes": list(self.basis_scenes), "map_file": self.map_file, "tolerance": self.tolerance,
                 "quantities": list(self.quantities), "inside_map": self.inside_map, "safe_choice": self.safe,
                 "predicted_wall_time_s": self.wall_time_s, "cost_basis": self.cost_basis,
+                "margin": None if self.margin is None else self.margin.value,
+                "margin_basis": None if self.margin is None else self.margin.text(),
                 "scene": asdict(self.scene) | {"name": self.scene.name}}
 
 
@@ -314,11 +387,11 @@ def _fmt(value) -> str:
 
 
 def choose(width_ratio, compression_ratio, slenderness=None, tolerance=None, quantities=None, rows=None,
-           path=None, runnable=None) -> Choice:
+           path=None, runnable=None, margin: Margin | None = None) -> Choice:
     """The cheapest candidate predicted within `tolerance` on `quantities` at the scene (W/L,
     dL/L, L/b; L/b None: the paper's thickness), from the map `rows` (default: read from `path`,
-    $DDG_ERROR_MAP or DEFAULT_MAP), else the safe choice with the reason. Inputs are checked first
-    (InputError)."""
+    $DDG_ERROR_MAP or DEFAULT_MAP), else the safe choice with the reason. `margin` None: the map's
+    cross-validated margin (RULE_V1_MARGIN: rule v1). Inputs are checked first (InputError)."""
     tolerance = check_tolerance(tolerance)
     quantities = check_quantities(quantities)
     strip = Strip.from_ratios(width_ratio, compression_ratio, slenderness)
@@ -335,26 +408,29 @@ def choose(width_ratio, compression_ratio, slenderness=None, tolerance=None, qua
     if not basis:
         return _safe(scene, tolerance, quantities, where, rows, inside=False,
                      reason=f"outside the error map: {outside}; nothing is extrapolated, so the safe choice")
-    found = predictions(rows, basis, runnable)
+    if margin is None:
+        margin = ON_A_MAP_SCENE if len(basis) == 1 else cross_validated_margin(rows, runnable)
+    found = predictions(rows, basis, runnable, margin.value)
     eligible = [p for p in found if p.within(tolerance, quantities) and p.wall_time_s is not None]
     if eligible:
         p = eligible[0]
         errors = ", ".join(f"{q} {_fmt(p.errors[q])}" for q in quantities)
         reason = (f"the cheapest of {len(eligible)} candidates predicted within {tolerance:g} on {names} "
                   f"(predicted error + reference error bar: {errors}; the largest over the bracketing map scenes "
-                  f"{', '.join(p.basis)})")
+                  f"{', '.join(p.basis)}, times the {margin.text()})")
         return Choice(p.model, p.resolution, p.label, reason, {q: p.errors[q] for q in QUANTITIES},
                       [s.name for s in basis], where, tolerance, quantities, scene, True, False, p.wall_time_s,
-                      f"largest wall time of {p.model} {p.label} on the basis scenes", found)
+                      f"largest wall time of {p.model} {p.label} on the basis scenes", found, margin)
     best = min(found, key=lambda p: p.worst(quantities), default=None)
     best_text = (f"; the closest is {best.model} {best.label} at {_fmt(best.worst(quantities))}"
                  if best is not None and math.isfinite(best.worst(quantities)) else "")
-    return _safe(scene, tolerance, quantities, where, rows, inside=True, basis=basis, candidates=found,
+    return _safe(scene, tolerance, quantities, where, rows, inside=True, basis=basis, candidates=found, margin=margin,
                  reason=(f"no candidate of the map is predicted within {tolerance:g} on {names} at the bracketing "
-                         f"scenes {', '.join(s.name for s in basis)}{best_text}: the safe choice"))
+                         f"scenes {', '.join(s.name for s in basis)} (their largest bound times the "
+                         f"{margin.text()}){best_text}: the safe choice"))
 
 
-def _safe(scene, tolerance, quantities, where, rows, inside, reason, basis=(), candidates=()) -> Choice:
+def _safe(scene, tolerance, quantities, where, rows, inside, reason, basis=(), candidates=(), margin=None) -> Choice:
     pair = list(safe_rows(scene.width_ratio))
     label = f"R{pair[0]}+R{pair[1]}"
     # cost: the plate's finer mesh on the map's scenes of the same dL/L (not this scene's), if any
@@ -370,7 +446,7 @@ def _safe(scene, tolerance, quantities, where, rows, inside, reason, basis=(), c
     return Choice(SAFE_MODEL, pair, label, reason + f" (the plate on the convergence pair {pair[0]}/{pair[1]} rows; "
                   "the difference of the two measures the finer one's discretisation error)", errors,
                   [s.name for s in basis], where, tolerance, quantities, scene, inside, True, wall, cost,
-                  list(candidates))
+                  list(candidates), margin)
 
 
 def study_mesh(model: str, strip: Strip, rows: int):
@@ -402,6 +478,8 @@ def format_choice(choice: Choice) -> str:
             mark = "" if q in choice.quantities else " (not asked)"
             lines.append(f"  predicted |{q} error| + reference error bar <= {_fmt(choice.predicted_errors[q])}{mark}")
         lines.append(f"  basis: {', '.join(choice.basis_scenes)}")
+    if choice.margin is not None:
+        lines.append(f"  {choice.margin.text()}")
     cost = "unknown" if choice.wall_time_s is None else f"about {choice.wall_time_s:.3g} s"
     lines.append(f"cost: {cost} ({choice.cost_basis})")
     if choice.candidates:

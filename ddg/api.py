@@ -346,7 +346,7 @@ def _static_run(name, instance, strip, protocol, resolution, options, out, progr
     closers = [bar.close] + ([writer.close] if writer is not None else [])
     run = Run(stepper, loading, lambda stage, state: observe(instance, state, stage, options.eigenvalues), summary,
               listeners, folder, [AfterStep(step.stage, step.run, step.checkpoint) for step in after], compressed,
-              make_result, closers, probe or SILENT)
+              make_result, closers, probe or SILENT, announce=bar.announce)
     return execute(run)
 
 

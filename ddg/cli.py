@@ -165,6 +165,23 @@ def _output_directory(out) -> Path:
     return check_output_directory(out, "--out")
 
 
+#: The files a run folder may hold, in the order the final line lists them (README "Outputs").
+RUN_FILES = ("path.csv", "summary.json", "centerline.csv", "branches.csv", "rod_path.csv", "frames/")
+
+
+def written_files(out: Path) -> list[str]:
+    """The run's files that exist in `out` (frames/ as a folder with its frame count), as paths."""
+    found = []
+    for name in RUN_FILES:
+        path = out / name.rstrip("/")
+        if name.endswith("/") and path.is_dir():
+            found.append(f"{path}/ ({len(list(path.glob('*.vtu')))} frames, frames.pvd)")
+        elif path.is_file():
+            found.append(str(path))
+    found += [str(p) for p in sorted((out / "auto_pair").glob("R*")) if p.is_dir()]
+    return found
+
+
 def _require_extra(module: str, extra: str) -> None:
     import importlib.util
 
@@ -248,7 +265,12 @@ def cmd_centerline_error(args) -> int:
         check_resolution("plate", args.resolution, strip)
     out = _output_directory(args.out)
     _require_extra("matplotlib", "plot")
-    rows = centerline_error_study(widths, shears, args.compression_ratio, args.resolution, args.slenderness)
+    from .protocol.progress import ProgressBar
+
+    bar = ProgressBar(len(widths) * len(shears), True, what="centerline-error study", unit="states")
+    rows = centerline_error_study(widths, shears, args.compression_ratio, args.resolution, args.slenderness,
+                                  progress=bar.update)
+    bar.close()
     columns = ("L_over_W", "W_over_L", "dW_over_L", "mean_error", "max_error", "rod_edge_mean_error",
                "ribbon_edge_mean_error", "phase", "triangles", "message")
     buf = _io.StringIO()
@@ -348,7 +370,7 @@ def _finish_simulate(args, result, auto: bool = False) -> int:
     if not args.quiet:
         keys = PRINTED_KEYS + (("auto",) if auto else ())
         print(json.dumps({k: s.get(k) for k in keys}, indent=2))
-        print(f"wrote {Path(args.out) / 'path.csv'} and {Path(args.out) / 'summary.json'}")
+        print(f"wrote {', '.join(written_files(Path(args.out)))}")
     if auto:
         block = s.get("auto") or {}
         sys.stderr.write(f"auto: {block.get('chosen_model')} {block.get('resolution_label')}: {block.get('reason')}\n")
@@ -422,7 +444,19 @@ def cmd_simulate_auto(args, strip: Strip, protocol: LoadingProtocol) -> int:
 
 def main(argv=None) -> int:
     """The command line; returns the exit code (0 complete, 2 bad input, 3 not converged,
-    130/143 interrupted by SIGINT/SIGTERM with every converged step written, 1 internal error)."""
+    130/143 interrupted by SIGINT/SIGTERM with every converged step written, 1 internal error).
+    The commands print summary.json's warnings themselves ("warning: ..."), so the API's
+    ValidityWarnings are silenced here, to say each once."""
+    import warnings
+
+    from .protocol.validity import ValidityWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ValidityWarning)
+        return _main(argv)
+
+
+def _main(argv=None) -> int:
     import os
     import signal as _signal
 

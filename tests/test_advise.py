@@ -99,6 +99,43 @@ def test_outside_the_map_is_the_safe_choice_and_says_so(map_csv):
     assert set(block) >= {"chosen_model", "resolution", "reason", "predicted_errors", "basis_scenes", "map_file"}
 
 
+def three_widths(plate_bounds=(0.003, 0.012, 0.008)):
+    """A plate at W/L = 1/20, 1/12 and 1/6 (dL/L = 1/2, the paper's L/b): 1/12 is bracketed by the others."""
+    return [_row(0.5, w, LB, "plate", 12, "R12", 100.0, (b, b, b)) for w, b in zip((0.05, 1 / 12, 1 / 6), plate_bounds)]
+
+
+def test_the_margin_is_the_worst_leave_one_out_ratio_on_the_fitting_scenes():
+    """Rule v2: W/L = 1/12 predicted from 1/20 and 1/6 by rule v1 is 0.008, measured 0.012: the margin is
+    1.5, and a scene between 1/12 and 1/6 is predicted at 1.5 times the worse of the two."""
+    from ddg.advise import cross_validated_margin, parse_rows
+
+    rows = parse_rows(three_widths())
+    margin = cross_validated_margin(rows)
+    assert margin.value == pytest.approx(1.5) and (margin.scenes, margin.compared) == (1, 3)
+    assert "plate R12" in margin.worst and "dL0.5_W0.08333_Lb1181" in margin.worst
+    c = choose(0.1, 0.5, None, 0.05, rows=rows)
+    assert c.predicted_errors == pytest.approx({"dW1": 0.018, "dW2": 0.018, "H_mid": 0.018})
+    block = c.auto_block()
+    assert block["margin"] == pytest.approx(1.5) and "leave-one-out" in block["margin_basis"]
+    # rule v1 on demand: the bare worst of the bracket
+    from ddg.advise import RULE_V1_MARGIN
+    assert choose(0.1, 0.5, None, 0.05, rows=rows, margin=RULE_V1_MARGIN).predicted_errors["dW1"] == 0.012
+
+
+def test_the_margin_is_at_least_one_and_ignores_held_out_rows():
+    from ddg.advise import cross_validated_margin, parse_rows
+
+    # rule v1 overstates here (predicted 0.008, measured 0.002): the margin stays 1, never below
+    assert cross_validated_margin(parse_rows(three_widths((0.003, 0.002, 0.008)))).value == 1.0
+    # no scene bracketed by the others: nothing to cross-validate, margin 1
+    lone = cross_validated_margin(parse_rows(three_widths()[:2]))
+    assert (lone.value, lone.compared) == (1.0, 0) and "nothing to cross-validate" in lone.text()
+    # a held-out scene with a huge error changes nothing
+    held = _row(0.5, 0.125, LB, "plate", 12, "R12", 100.0, (0.5, 0.5, 0.5))
+    held["role"] = "held-out"
+    assert cross_validated_margin(parse_rows(three_widths() + [held])).value == pytest.approx(1.5)
+
+
 def test_an_empty_or_missing_default_map_is_outside(tmp_path, monkeypatch):
     import ddg.advise as advise
 

@@ -96,6 +96,23 @@ def test_held_out_check_leaves_each_scene_out():
     assert middle["choice_measured"] == pytest.approx(0.012)
 
 
+def test_rule_v2_carries_the_margin_measured_on_the_fitting_scenes():
+    """A held-out W/L = 1/8 measured at 0.016: rule v1 predicts the worse of 1/12 and 1/6 (0.012) and
+    fails; rule v2 multiplies by the leave-one-out margin of the fitting scenes (1/12 measured 0.012
+    against 0.008 predicted from 1/20 and 1/6: 1.5) and holds. For the fitting scene 1/12 itself
+    the margin is measured without it (nested): no other scene is bracketed, margin 1."""
+    lb = 1181.1023622047244
+    rows = [_map_row(w, lb, "plate", "R12", 100.0, b) for w, b in ((0.05, 0.003), (1 / 12, 0.012), (1 / 6, 0.008))]
+    held = _map_row(0.125, lb, "plate", "R12", 100.0, 0.016)
+    held["role"] = "held-out"
+    v1 = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05, rule="v1")}
+    v2 = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05)}
+    e1, e2 = v1["dL0.5_W0.125_Lb1181"], v2["dL0.5_W0.125_Lb1181"]
+    assert (e1["compared"], e1["held"], e1["margin"]) == (3, 0, 1.0)
+    assert (e2["compared"], e2["held"]) == (3, 3) and e2["margin"] == pytest.approx(1.5)
+    assert v2["dL0.5_W0.08333_Lb1181"]["margin"] == 1.0 and v2["dL0.5_W0.08333_Lb1181"]["held"] == 0
+
+
 def test_cheapest_within_and_combined_error():
     lb = 1181.1
     rows = [_map_row(0.05, lb, "rod", "M100", 1.0, 0.02), _map_row(0.05, lb, "plate", "R12", 50.0, 0.009),

@@ -189,3 +189,21 @@ def test_resolution_of_seven_nodes_is_the_smallest_accepted():
     assert Centerline(0.1, 7).edges == 6
     with pytest.raises(InputError, match=r"M = 6\b"):
         Centerline(0.1, 6)
+
+
+def test_compression_ratio_has_one_source():
+    """dL/L sets the paper strip's length (Strip.from_ratios: L = 75 mm / (1 - dL/L)) and the loading:
+    a protocol with another dL/L is refused before any work, in one line naming both values; a strip
+    given by its lengths takes any compression; the check is in every entry (API, CLI, FEM)."""
+    strip = Strip.from_ratios(0.05, 0.5)
+    assert strip.design_compression_ratio == 0.5
+    assert LoadingProtocol(0.5).resolved_shear_ratio(strip) > 0
+    with pytest.raises(InputError) as info:
+        ddg.simulate(strip, LoadingProtocol(0.25), model="rod")
+    text = str(info.value)
+    assert "\n" not in text and "0.25" in text and "0.5" in text and "Strip.from_ratios" in text
+    free = Strip(length=strip.length, width=strip.width, thickness=strip.thickness)
+    assert free.design_compression_ratio is None and free == strip   # the same geometry, compared equal
+    assert LoadingProtocol(0.25).resolved_shear_ratio(free) > 0
+    with pytest.raises(InputError):
+        Strip(length=0.15, width=0.01, thickness=1e-4, design_compression_ratio=1.5)

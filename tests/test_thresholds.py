@@ -71,16 +71,20 @@ def test_thresholds_do_not_depend_on_the_size_of_the_kick(narrow_rod):
 
 
 def test_phase_labels_follow_U_then_US_then_S(narrow_rod):
-    """Up to 0.03 L before dW_max (there the strip is pulled nearly straight, its deflection falls
-    below 0.5 % of L and the S lobes swap sides: S- from dW/L = 0.797 of 0.8175)."""
+    """The whole path to dW_max keeps its branch's sign. Near dW_max the strip is pulled nearly
+    straight, its deflection falls below 0.5 % of L and the out-of-plane profile of S reverses
+    continuously (rise() changes sign at dW/L = 0.797 of 0.8175: the path used to end labelled
+    S-); the sign is now carried along the path (ddg.solve.state.BranchOrientation)."""
     result = narrow_rod[100]
-    dw_all = result.column("dW_over_L", "shear")
-    keep = dw_all < result.summary["dW_max_over_L"] - 0.03
-    phases = [p for p, k in zip(result.column("phase", "shear"), keep) if k]
-    dw = dw_all[keep]
+    dw = result.column("dW_over_L", "shear")
+    phases = list(result.column("phase", "shear"))
     order = {"U": 0, "US+": 1, "S+": 2}
     ranks = [order.get(p, 3) for p in phases]
     assert ranks == sorted(ranks) and set(phases) == {"U", "US+", "S+"}
+    assert dw[-1] > result.summary["dW_max_over_L"] - 0.01
+    keep = dw < result.summary["dW_max_over_L"] - 0.03
+    phases = [p for p, k in zip(phases, keep) if k]
+    dw = dw[keep]
     summary = result.summary
     first_us = dw[phases.index("US+")]
     first_s = dw[phases.index("S+")]
@@ -88,6 +92,32 @@ def test_phase_labels_follow_U_then_US_then_S(narrow_rod):
     assert dw[phases.index("S+") - 1] < summary["dW2_over_L"] <= first_s + 1e-12
     h = result.column("H_mid_over_L", "shear")[keep]
     assert np.all(np.abs(h[np.array([p.startswith("S") for p in phases])]) < 1e-8)
+
+
+def test_the_minus_branch_keeps_its_label_to_dW_max():
+    """--branch -: U, US-, S- and nothing else up to dW_max (the mirror image of the + path)."""
+    strip = ddg.Strip.from_ratios(0.05, 0.5)
+    protocol = ddg.LoadingProtocol(0.5, compression_steps=20)
+    result = ddg.simulate(strip, protocol, model="rod", resolution=100, branches=False, thresholds=False,
+                          options=ddg.ContinuationOptions(branch_sign=-1))
+    phases = list(result.column("phase", "shear"))
+    ranks = [{"U": 0, "US-": 1, "S-": 2}.get(p, 3) for p in phases]
+    assert ranks == sorted(ranks) and set(phases) == {"U", "US-", "S-"}
+
+
+def test_branch_orientation_keeps_the_sign_through_a_smooth_reversal():
+    """A unit check of the rule: the odd part rotating by small steps from +e to -e keeps the first
+    label; a jump to the opposite vector flips it; U clears the memory."""
+    from ddg.solve.state import BranchOrientation
+
+    o = BranchOrientation()
+    assert o.label("U", lambda: 1 / 0) == "U"          # odd_part not asked on U
+    angles = np.linspace(0.0, np.pi, 40)
+    labels = [o.label("S+" if np.cos(a) > 0 else "S-", lambda a=a: np.array([np.cos(a), np.sin(a)])) for a in angles]
+    assert set(labels) == {"S+"}
+    assert o.label("S-", lambda: np.array([1.0, 0.0])) == "S-"   # a jump to the mirror branch
+    assert o.label("U", lambda: None) == "U"
+    assert o.label("US-", lambda: np.array([0.0, 1.0])) == "US-"  # a fresh start takes rise()'s sign
 
 
 def test_reported_stable_states_have_positive_lambda_min(narrow_rod):

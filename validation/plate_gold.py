@@ -27,7 +27,7 @@ from ddg.output.io import atomic_write_text, finished_run_summary, read_json_obj
 from ddg.solve.thresholds import THRESHOLD_TOLERANCES
 
 #: Rows of triangles across W on the coarsest mesh (a multiple of 8: 1.5 and 2.25 times it stay even).
-BASE_ROWS = {1 / 20: 8, 1 / 12: 8, 1 / 8: 8, 1 / 6: 8, 1 / 4: 16, 1 / 3: 16, 1 / 2: 16}
+BASE_ROWS = {1 / 20: 8, 1 / 12: 8, 1 / 10: 8, 1 / 8: 8, 1 / 6: 8, 1 / 4: 16, 1 / 3: 16, 1 / 2: 16}
 REFINEMENT = 1.5
 LEVELS = 3
 #: The DDG's threshold bisection brackets (ddg.solve.thresholds), for runs stored before their

@@ -101,10 +101,11 @@ def edge_reconstruction(model, q: np.ndarray) -> dict:
 
 def centerline_error_study(width_ratios=PAPER_WIDTH_RATIOS, shear_ratios=PAPER_SHEAR_RATIOS, compression_ratio=0.5,
                            triangles: int = 800, slenderness: float | None = None, max_step: float = 0.05,
-                           options=None) -> list[dict]:
+                           options=None, progress=None) -> list[dict]:
     """Fig. 10: mean and max of delta (Eq. 13) against L/W at each dW/L, one plate run per width
     along its stable path (branch switching on). A run that stops converging records NaN for the
-    shears it did not reach, with the message."""
+    shears it did not reach, with the message. progress(text) is called after each (width, shear)
+    state is measured (e.g. ddg.protocol.progress.ProgressBar.update)."""
     from .curvatures import states_at_shears
     from ..solve.continuation import ContinuationFailure
 
@@ -130,6 +131,8 @@ def centerline_error_study(width_ratios=PAPER_WIDTH_RATIOS, shear_ratios=PAPER_S
                              "rod_edge_mean_error": edges["rod_mean"], "ribbon_edge_mean_error": edges["ribbon_mean"],
                              "phase": phase_label(model, state.q, state.compression, state.shear),
                              "triangles": model.mesh.triangle_count, "message": ""})
+                if progress is not None:
+                    progress(f"W/L = {ratio:.4g}, dW/L = {shear:.3g}: mean delta {field['mean']:.2e}")
         except ContinuationFailure as exc:
             message = str(exc)
         for r in shear_ratios:

@@ -53,7 +53,7 @@ def _import_meshio():
     except ImportError:
         raise InputError(
             "reading or writing meshes needs meshio, which is not installed; "
-            "install it with `apt-get install python3-meshio` (Debian) or `pip install meshio`"
+            "pip install 'ddg-strips[io]' (or Debian's python3-meshio)"
         ) from None
     return meshio
 

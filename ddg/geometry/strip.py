@@ -8,7 +8,7 @@ moved toward the other by dL along x (compression), then translated by dW along 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 #: Paper defaults (section 2): clamps 75 mm apart after compression, shim stock b = 0.127 mm.
 CLAMP_SPAN_AFTER_COMPRESSION = 75e-3
@@ -94,10 +94,16 @@ class Strip:
     young_modulus: float = PAPER_YOUNG_MODULUS
     poisson_ratio: float = 0.0
     density: float = 1390.0  # polyester shim stock, kg/m^3; used only by the dynamic (Eq. 7) option
+    #: dL/L whose scene from_ratios built (L = 75 mm / (1 - dL/L)); the loading protocol must then
+    #: compress by the same dL/L (LoadingProtocol.resolved_shear_ratio checks it). None for a strip
+    #: given by its lengths, which any compression may load.
+    design_compression_ratio: float | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         for name in ("length", "width", "thickness", "young_modulus", "density"):
             object.__setattr__(self, name, _finite_positive(name, getattr(self, name)))
+        if self.design_compression_ratio is not None:
+            object.__setattr__(self, "design_compression_ratio", _compression_ratio(self.design_compression_ratio))
         nu = self.poisson_ratio
         if _is_bool(nu):
             raise InputError(f"poisson_ratio = {nu!r} is a bool; allowed range [0, 0.5)")
@@ -145,7 +151,8 @@ class Strip:
             _require(low <= slenderness <= high, f"slenderness L/b = {slenderness:g} outside the allowed range "
                      f"[{low:g}, {high:g}]: a thin strip (b << L) within round-off of double precision")
             thickness = length / slenderness
-        return cls(length=length, width=width_ratio * length, thickness=thickness, **material)
+        return cls(length=length, width=width_ratio * length, thickness=thickness,
+                   design_compression_ratio=compression_ratio, **material)
 
     # --- derived quantities -------------------------------------------------------------
     @property
@@ -275,7 +282,14 @@ class LoadingProtocol:
             object.__setattr__(self, "shear_ratio", value)
 
     def resolved_shear_ratio(self, strip: Strip) -> float:
-        """Largest dW/L of the run, checked against the shear limit of Eq. (B.1)."""
+        """Largest dW/L of the run, checked against the shear limit of Eq. (B.1); and the compression
+        against the one the strip was built for (Strip.from_ratios): dL/L has one source."""
+        design = strip.design_compression_ratio
+        if design is not None:
+            _require(abs(design - self.compression_ratio) <= 1e-12 * design,
+                     f"compression_ratio dL/L = {self.compression_ratio:g} of the loading protocol differs from the "
+                     f"dL/L = {design:g} the strip was built for (Strip.from_ratios sets L = 75 mm / (1 - dL/L)); "
+                     "give the same value to both, or build the strip with Strip(length=..., width=..., thickness=...)")
         limit = strip.shear_limit(self.compression_ratio * strip.length) / strip.length
         if self.shear_ratio is None:
             return limit

@@ -156,18 +156,59 @@ def read_numeric_rows(path: Path) -> list[dict]:
     return out
 
 
-class StoredRun:
-    """A finished output folder read back: `.rows` (path.csv, numbers parsed), `.summary`
-    (summary.json), `.converged` and `.column(name, stage)`; any model writes this contract."""
+class PathTable:
+    """The recorded rows of a run (path.csv: one row per recorded equilibrium, README "Outputs")
+    as numpy arrays or a pandas DataFrame; shared by SimulationResult and StoredRun."""
+
+    rows: list[dict]
+
+    def column(self, name: str, stage: str | None = None) -> np.ndarray:
+        """One column of path.csv as a numpy array, e.g. column("H_mid_over_L", "shear"): every
+        recorded row, or those of `stage` ("compression" or "shear"). Columns (README): stage,
+        dL_over_L, dW_over_L (dL/L, dW/L), H_mid_over_L (mid-point height / L), F_shear_norm
+        (F_y L / (E b^3), App. E), energy (J), lambda_min (lowest eigenvalue, normalised), phase (U,
+        US+, US-, S+, S-), then F_axial_norm, stable, newton_iterations, branch_switched,
+        max_turn_angle_deg, max_strain, negative_eigenvalues. KeyError naming the columns for an
+        unknown name."""
+        rows = self.rows if stage is None else [r for r in self.rows if r["stage"] == stage]
+        if rows and name not in rows[0]:
+            raise KeyError(f"no column {name!r}; the columns are {', '.join(rows[0])}")
+        return np.array([r[name] for r in rows])
+
+    def arrays(self, stage: str | None = None) -> dict[str, np.ndarray]:
+        """Every column as a numpy array (of `stage`'s rows if given): {name: array}."""
+        rows = self.rows if stage is None else [r for r in self.rows if r["stage"] == stage]
+        names = list(rows[0]) if rows else list(PATH_COLUMNS + EXTRA_COLUMNS)
+        return {name: np.array([r.get(name) for r in rows]) for name in names}
+
+    def to_dataframe(self, stage: str | None = None):
+        """The rows as a pandas DataFrame (pandas: Debian python3-pandas, or pip install
+        'ddg-strips[dataframe]'); ImportError in one line naming it when pandas is missing."""
+        try:
+            import pandas
+        except ImportError:
+            raise ImportError("to_dataframe needs pandas, which is not installed: pip install 'ddg-strips[dataframe]' "
+                              "(or apt install python3-pandas); result.arrays() gives numpy arrays without it") from None
+        return pandas.DataFrame(self.arrays(stage))
+
+
+class StoredRun(PathTable):
+    """A finished output folder read back, for any model (they all write this contract):
+    `.rows` (path.csv, numbers parsed), `.summary` (summary.json as a dict), `.converged`,
+    `.directory`; `.column(name, stage)`, `.arrays()`, `.to_dataframe()` (PathTable), and
+    `.branch_rows` (branches.csv where it exists, else []). ddg.read_run(directory) is this."""
 
     def __init__(self, directory):
         self.directory = Path(directory)
         self.summary = json.loads((self.directory / "summary.json").read_text())
         self.rows = read_numeric_rows(self.directory / "path.csv")
         self.converged = bool(self.summary.get("converged"))
+        branches = self.directory / "branches.csv"
+        self.branch_rows = read_numeric_rows(branches) if branches.is_file() else []
 
-    def column(self, name: str, stage: str | None = None) -> np.ndarray:
-        return np.array([r[name] for r in self.rows if stage is None or r["stage"] == stage])
+    def __repr__(self) -> str:
+        return (f"StoredRun({str(self.directory)!r}: {self.summary.get('model')}, {len(self.rows)} rows, "
+                f"status {self.summary.get('status')})")
 
 
 def check_output_directory(out, name: str = "out") -> Path:

@@ -24,6 +24,8 @@ from typing import Callable, Protocol, Sequence
 from ..geometry.strip import LoadingProtocol, Strip
 from ..output.interrupts import interrupt_behind
 from ..solve.probe import SILENT, Probe
+from ..solve.state import BranchOrientation, half_turn_odd_part
+from .validity import add_validity_warnings, raise_warnings
 from .results import SimulationResult, finish_summary
 
 
@@ -114,6 +116,7 @@ class Run:
     close: Sequence[Callable[[], None]] = ()                 # writers and progress bars to close
     probe: Probe = SILENT                                    # told of every recorded step and its wall time
     started: float | None = None                             # perf_counter() at the run's start (else execute's)
+    announce: Callable[..., None] | None = None              # told (stage) / (stage, done=True) around each AfterStep
 
 
 def follow(run: Run) -> PathOutcome:
@@ -121,9 +124,16 @@ def follow(run: Run) -> PathOutcome:
     interrupt (they end the walk and are kept in the outcome)."""
     stepper, out = run.stepper, PathOutcome()
     clock = [time.perf_counter()]
+    model = getattr(stepper, "model", None)
+    # ddg's models name branches by continuity (BranchOrientation); a model without symmetry
+    # partners (the FEM shell, whose states are observations) keeps the labels it gives
+    orientation = BranchOrientation() if hasattr(model, "symmetry_partners") else None
 
     def record(stage: str, state) -> None:
         row = run.observe(stage, state)
+        if orientation is not None and row.get("phase") and hasattr(state, "q"):
+            row["phase"] = orientation.label(row["phase"], lambda: half_turn_odd_part(
+                model, state.q, state.compression, state.shear))
         out.rows.append(row)
         out.state = state
         for listener in run.listeners:
@@ -193,7 +203,11 @@ def execute(run: Run) -> SimulationResult:
                 out.stage = step.stage
                 if run.folder is not None:
                     run.folder.checkpoint({**run.summary, "message": step.checkpoint or f"running: {step.stage}"})
+                if run.announce is not None:
+                    run.announce(step.stage)
                 step.run(out)
+                if run.announce is not None:
+                    run.announce(step.stage, done=True)
         except KeyboardInterrupt as exc:
             out.interrupted = exc
         except Exception as exc:  # noqa: BLE001  (written as status "error", then re-raised)
@@ -205,6 +219,8 @@ def execute(run: Run) -> SimulationResult:
     finish_summary(run.summary, out.rows, path_complete=out.complete, stopped=out.stopped,
                    interrupted=out.interrupted, stage=out.stage, error=out.error)
     _model_stop_note(run, out)
+    if out.error is None:
+        add_validity_warnings(run.summary, out.rows)
     result = (run.make_result(out) if run.make_result is not None
               else SimulationResult(out.rows, run.summary, out.state, run.stepper.model))
     if run.folder is not None:
@@ -213,6 +229,7 @@ def execute(run: Run) -> SimulationResult:
     if raised is not None:
         raised.result = result
         raise raised
+    raise_warnings(run.summary)
     return result
 
 

@@ -17,13 +17,23 @@ from ..analysis.observables import resolved_up_to
 from ..geometry.strip import LoadingProtocol, Strip
 from ..output.interrupts import signal_name_of
 from ..solve.thresholds import THRESHOLD_TOLERANCES
-from ..output.io import (STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED, write_centerline_csv, write_path_csv,
-                         write_summary_json)
+from ..output.io import (STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED, PathTable, write_centerline_csv,
+                         write_path_csv, write_summary_json)
 from ..version import __version__
 
 
 @dataclass
-class SimulationResult:
+class SimulationResult(PathTable):
+    """What ddg.simulate returns: the run's recorded path and summary, as written to its folder.
+
+    rows: one dict per recorded equilibrium, the columns of path.csv (PathTable.column lists
+    them; normalised: dW/L, H_mid/L, F L/(E b^3)); summary: summary.json as a dict (thresholds
+    dW1_over_L, dW2_over_L, status, converged, message, warnings, ... README "Outputs");
+    final_state: the last converged ddg.solve.state.State (SI units: q in m and rad); model: the
+    model object (its positions(q), midpoint(q), ...); centerlines: per row the (stations, 3)
+    positions of the centreline w = 0 (m); branch_rows: the rows of branches.csv (every branch,
+    stable or not), when traced. `column(name, stage)`, `arrays()` and `to_dataframe()` read the
+    rows (PathTable); `converged` is summary["converged"]; `write(out)` writes the files."""
     rows: list[dict]
     summary: dict
     final_state: object = None
@@ -33,11 +43,8 @@ class SimulationResult:
 
     @property
     def converged(self) -> bool:
+        """The loading path reached its end with every step converged (summary["converged"])."""
         return bool(self.summary["converged"])
-
-    def column(self, name: str, stage: str | None = None) -> np.ndarray:
-        rows = self.rows if stage is None else [r for r in self.rows if r["stage"] == stage]
-        return np.array([r[name] for r in rows])
 
     def write(self, out: str | Path) -> None:
         out = Path(out)

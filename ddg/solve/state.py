@@ -55,14 +55,61 @@ def symmetry_defects(model, q: np.ndarray, compression: float, shear: float) -> 
     under neither (section 4 of the paper).
     """
     L = model.strip.length
+    a, b, c = _partners(model, q, compression, shear)
+    point = 2 * c - b
+    return (float(np.max(np.linalg.norm(a - _half_turn(b, c), axis=1))) / L,
+            float(np.max(np.linalg.norm(a - point, axis=1))) / L)
+
+
+def _partners(model, q, compression, shear):
     x = model.positions(q)
     nodes, partners = model.symmetry_partners()
-    c = np.array([0.5 * (L - compression), 0.5 * shear, 0.0])
-    a, b = x[nodes], x[partners]
-    half_turn = np.stack([2 * c[0] - b[:, 0], 2 * c[1] - b[:, 1], b[:, 2]], axis=1)
-    point = 2 * c - b
-    return (float(np.max(np.linalg.norm(a - half_turn, axis=1))) / L,
-            float(np.max(np.linalg.norm(a - point, axis=1))) / L)
+    c = np.array([0.5 * (model.strip.length - compression), 0.5 * shear, 0.0])
+    return x[nodes], x[partners], c
+
+
+def _half_turn(b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    return np.stack([2 * c[0] - b[:, 0], 2 * c[1] - b[:, 1], b[:, 2]], axis=1)
+
+
+def half_turn_odd_part(model, q: np.ndarray, compression: float, shear: float) -> np.ndarray:
+    """The part of the shape that the half turn reverses (relative to L): (x(p) - R x(p')) / 2 over
+    the symmetry partners p, p' (flattened). Zero on U; the half turn maps US+ to US- and S+ to S-,
+    and flips this vector: its orientation relative to a neighbouring state's names the branch
+    (BranchOrientation)."""
+    a, b, c = _partners(model, q, compression, shear)
+    return (0.5 * (a - _half_turn(b, c)) / model.strip.length).ravel()
+
+
+class BranchOrientation:
+    """The + / - of US and S kept along a continuous path (issue 18: the sign of rise() alone turns
+    S+ into S- near dW_max, where the lobes of S flatten and the out-of-plane profile reverses
+    continuously; measured on the rod at W/L = 1/20, dL/L = 1/2: rise() changes sign at dW/L =
+    0.80 while the path is one smooth branch). The first asymmetric state after U (or after the
+    start) takes the sign of phase_label (rise()); every later one keeps its predecessor's sign if
+    their half-turn-odd parts (half_turn_odd_part) point the same way (positive inner product), else
+    the opposite one: a label changes only where the shape jumps to the mirror branch. Back on U
+    (or flat) the memory is cleared."""
+
+    def __init__(self):
+        self._last: tuple[str, np.ndarray] | None = None
+
+    def label(self, phase: str, odd_part: Callable[[], np.ndarray]) -> str:
+        """The oriented label of a state whose phase_label is `phase`; odd_part() is called only
+        for US and S."""
+        base = phase.rstrip("+-")
+        if base in ("", "U"):
+            self._last = None
+            return phase
+        odd = np.asarray(odd_part(), dtype=float)
+        if self._last is None:
+            sign = phase[-1]
+        else:
+            previous, before = self._last
+            same = float(np.dot(odd, before)) >= 0.0
+            sign = previous if same else ("-" if previous == "+" else "+")
+        self._last = (sign, odd)
+        return base + sign
 
 
 def rise(model, q: np.ndarray) -> float:

@@ -82,11 +82,13 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
 
 
 def _frame_writer(model, directory: Path):
-    from .output.frames import FrameWriter, polyline_cells
+    """Frames of a plate as its triangles, of a rod or ribbon as the strip of width W it stands for
+    (ddg.output.frame_fields)."""
+    from .output.frame_fields import frame_cells
+    from .output.frames import FrameWriter
 
-    if hasattr(model, "mesh"):
-        return FrameWriter(directory, model.mesh)
-    return FrameWriter(directory, polyline_cells(model.nodes), reference=model.rest_state()[model.node_dofs])
+    cells, flat = frame_cells(model)
+    return FrameWriter(directory, cells, reference=flat, cell_type="triangle")
 
 
 def _model_class(name: str):
@@ -156,7 +158,7 @@ def _open_folder(out, summary: dict):
     return RunFolder(out, summary)
 
 
-def _recorders(model, folder, progress_bar, writer=None):
+def _recorders(model, folder, progress_bar, writer=None, compression_ratio: float = 0.0):
     """Listeners every model's run has: path.csv row by row, the centerline per row, frames,
     progress; returns (listeners, centerlines)."""
     centerlines: list[np.ndarray] = []
@@ -169,9 +171,14 @@ def _recorders(model, folder, progress_bar, writer=None):
         listeners.append(lambda stage, state, row: folder.append(row))
     listeners.append(keep_centerline)
     if writer is not None:
+        from .output.frame_fields import frame_content
+
         def write_frame(stage, state, row):
-            writer.write(model.positions(state.q), step=len(centerlines) - 1, dL_over_L=row["dL_over_L"],
-                         dW_over_L=row["dW_over_L"], stage=stage)
+            points, cells = frame_content(model, state.q)
+            # ParaView's time: dW/L on the shear, dL/L - dL_end/L (<= 0) on the compression
+            time = row["dW_over_L"] if stage == "shear" else row["dL_over_L"] - compression_ratio
+            writer.write(points, step=len(centerlines) - 1, dL_over_L=row["dL_over_L"], dW_over_L=row["dW_over_L"],
+                         stage=stage, cell_data=cells, time=time)
 
         listeners.append(write_frame)
     listeners.append(progress_bar)
@@ -307,7 +314,7 @@ def _static_run(name, instance, strip, protocol, resolution, options, out, progr
     folder = _open_folder(out, summary)
     writer = _frame_writer(instance, Path(out) / "frames") if frames else None
     bar = ProgressBar(len(loading.compression) + len(loading.shear) + 1, progress)
-    listeners, centerlines = _recorders(instance, folder, bar, writer)
+    listeners, centerlines = _recorders(instance, folder, bar, writer, protocol.compression_ratio)
     stepper = stepper or StaticStepper(instance, options, probe=probe)
     after, on_compressed, branch_step = [], [], None
     extra_rows = {}

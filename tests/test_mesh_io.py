@@ -447,7 +447,9 @@ def test_frame_writer_writes_vtu_frames_and_a_collection(tmp_path):
             positions = np.column_stack([mesh.nodes, np.zeros(mesh.node_count)]) + 1e-3 * rng.random((mesh.node_count,
                                                                                                       3))
             path = writer.write(positions, step=k, dL_over_L=0.5, dW_over_L=0.01 * k, stage="shear",
-                                point_data={"height": positions[:, 2]})
+                                point_data={"height": positions[:, 2]},
+                                cell_data={"area_index": np.arange(mesh.triangle_count, dtype=float)},
+                                time=0.01 * k)
             written.append(positions)
             # the collection is valid after every frame (an interrupted run keeps it)
             datasets = _pvd_datasets(directory / "frames.pvd")
@@ -455,16 +457,20 @@ def test_frame_writer_writes_vtu_frames_and_a_collection(tmp_path):
             assert path == directory / f"frame_{k:05d}.vtu"
 
     datasets = _pvd_datasets(directory / "frames.pvd")
-    assert [int(d.get("timestep")) for d in datasets] == [0, 1, 2, 3]
+    assert [float(d.get("timestep")) for d in datasets] == [0.0, 0.01, 0.02, 0.03]   # the time given: dW/L
+    assert [int(d.get("step")) for d in datasets] == [0, 1, 2, 3]
     assert [float(d.get("dW_over_L")) for d in datasets] == [0.0, 0.01, 0.02, 0.03]
     assert {d.get("stage") for d in datasets} == {"shear"}
     for k, positions in enumerate(written):
         points, point_data, meta = read_frame(directory / f"frame_{k:05d}.vtu")
         np.testing.assert_array_equal(points, positions)
-        np.testing.assert_allclose(point_data["displacement"],
-                                   positions - np.column_stack([mesh.nodes, np.zeros(mesh.node_count)]), atol=1e-15)
+        # the flat reference, not a displacement (Warp By Vector would deform twice)
+        assert "displacement" not in point_data
+        np.testing.assert_array_equal(point_data["flat_position"],
+                                      np.column_stack([mesh.nodes, np.zeros(mesh.node_count)]))
         np.testing.assert_array_equal(point_data["height"], positions[:, 2])
-        assert meta == {"step": k, "dL_over_L": 0.5, "dW_over_L": 0.01 * k, "stage": "shear"}
+        np.testing.assert_array_equal(point_data["cell:area_index"], np.arange(mesh.triangle_count))
+        assert meta == {"step": k, "time": 0.01 * k, "dL_over_L": 0.5, "dW_over_L": 0.01 * k, "stage": "shear"}
     assert sorted(p.name for p in directory.iterdir()) == ["frame_00000.vtu", "frame_00001.vtu",
                                                            "frame_00002.vtu", "frame_00003.vtu", "frames.pvd"]
 
@@ -484,10 +490,11 @@ def test_frame_writer_writes_a_polyline_and_keeps_triangles_as_cells(tmp_path):
     for step in (0, 5):
         rod.write(centerline + [0, 0, 1e-3 * step], step=step, stage="compress")
     rod.close()
-    assert [int(d.get("timestep")) for d in _pvd_datasets(tmp_path / "rod" / "frames.pvd")] == [0, 5]
+    assert [int(d.get("step")) for d in _pvd_datasets(tmp_path / "rod" / "frames.pvd")] == [0, 5]
     line = meshio.read(tmp_path / "rod" / "frame_00005.vtu")
     assert [c.type for c in line.cells] == ["line"] and len(line.cells[0].data) == 10
-    np.testing.assert_allclose(line.point_data["displacement"][:, 2], 5e-3)
+    np.testing.assert_allclose(line.points[:, 2], 5e-3)
+    np.testing.assert_allclose(line.point_data["flat_position"], centerline)
 
 
 def test_frame_writer_leaves_no_temporary_file_when_a_write_fails(tmp_path, monkeypatch):

@@ -116,7 +116,8 @@ def test_render_frame_title_has_the_phase_from_path_csv(rod_run, tmp_path):
     title = render.title_of(frame, run.phase(step), "rod")
     assert f"step {step} (shear)" in title and run.phase(step) in title and "dW/L = " in title
     assert frame.width == pytest.approx(1 / 20)
-    assert frame.clamped[0].sum() == 2 and frame.clamped[1].sum() == 2  # the rod's clamped end edges
+    # the rod's clamped end edges, drawn as a ribbon: two nodes, each with both sides of the strip
+    assert frame.clamped[0].sum() == 4 and frame.clamped[1].sum() == 4 and frame.kind == "plate"
     assert render.render_frame(run.files[step], tmp_path / "f.png") == tmp_path / "f.png"
     assert_drawn(tmp_path / "f.png")
 

@@ -1,13 +1,18 @@
 """Deformed shapes for ParaView: one VTU file per recorded step and a `frames.pvd` collection.
 
-Each `frame_NNNNN.vtu` holds the deformed node positions (N, 3), the cells (triangles of the
-plate mesh, or line segments of a rod's centerline), the point array `displacement` from the
-flat reference, any extra per-node arrays, and field data `TimeValue` and `step` (the step
-index), `dL_over_L`, `dW_over_L` and `stage` (the stage name as UTF-8 byte codes; VTK string
-arrays would make the file unreadable to meshio). `frames.pvd` lists the frames with
-timestep = step index and carries dL_over_L, dW_over_L and stage as attributes; it is rewritten
-after every frame, and every file is written atomically, so an interrupted run leaves a valid
-collection of complete frames. meshio is imported lazily (Debian python3-meshio).
+Each `frame_NNNNN.vtu` holds the deformed node positions (N, 3) as its points, the cells
+(triangles: the plate mesh, or the ribbon a rod stands for, ddg.output.frame_fields; or line
+segments), the point array `flat_position` (the flat reference; not a displacement, which Warp
+By Vector would add to the already deformed points), any extra per-node and per-cell arrays
+(e.g. turn_angle_deg and bending_energy_density of the plate, k1_L, k2_L, tau_L of the rod), and
+field data `TimeValue`, `step` (the step index), `dL_over_L`, `dW_over_L` and `stage` (the stage
+name as UTF-8 byte codes; VTK string arrays would make the file unreadable to meshio).
+`frames.pvd` lists the frames with timestep = the frame's time (ddg.simulate gives dW/L on the
+shear, and dL/L - dL_end/L <= 0 on the compression, so that ParaView's time axis reads the shear
+directly and the whole protocol stays monotone) and carries step, dL_over_L, dW_over_L and stage
+as attributes; it is rewritten after every frame, and every file is written atomically, so an
+interrupted run leaves a valid collection of complete frames. meshio is imported lazily (Debian
+python3-meshio).
 """
 from __future__ import annotations
 
@@ -24,6 +29,8 @@ from .io import atomic_path, atomic_write_text
 CELL_NODES = {"triangle": 3, "line": 2}
 
 COLLECTION_NAME = "frames.pvd"
+#: The point array holding the flat reference positions.
+REFERENCE_ARRAY = "flat_position"
 
 
 def _import_meshio():
@@ -55,9 +62,9 @@ def _as_points(array, name: str) -> np.ndarray:
 class FrameWriter:
     """Write `directory/frame_NNNNN.vtu` per step and keep `directory/frames.pvd` up to date.
 
-    mesh_or_cells: a PlateMesh (triangles; the flat mesh is the displacement reference) or
-    integer cells (C, 3) / (C, 2) with cell_type "triangle" / "line" (inferred from the shape
-    when omitted) and optional reference positions (N, 2|3) for the displacement array.
+    mesh_or_cells: a PlateMesh (triangles; the flat mesh is the reference) or integer cells
+    (C, 3) / (C, 2) with cell_type "triangle" / "line" (inferred from the shape when omitted)
+    and optional flat reference positions (N, 2|3), written as the point array flat_position.
     """
 
     def __init__(self, directory, mesh_or_cells, *, reference=None, cell_type: str | None = None,
@@ -100,10 +107,13 @@ class FrameWriter:
         return [self.directory / self._entries[s]["file"] for s in sorted(self._entries)]
 
     def write(self, positions, *, step: int | None = None, dL_over_L: float = math.nan,
-              dW_over_L: float = math.nan, stage: str = "", point_data: dict | None = None) -> Path:
+              dW_over_L: float = math.nan, stage: str = "", point_data: dict | None = None,
+              cell_data: dict | None = None, time: float | None = None) -> Path:
         """Write one frame (deformed positions (N, 3) or (N, 2)) and rewrite the collection.
 
         step defaults to one past the last step written; writing a step again replaces it.
+        cell_data: {name: (C,) or (C, k) array} per cell; time: the frame's time value in the
+        collection and the file (default the step index).
         """
         if self._closed:
             raise RuntimeError("FrameWriter is closed")
@@ -117,11 +127,14 @@ class FrameWriter:
             raise InputError(f"step = {step!r} must be a non-negative integer")
         step = int(step)
 
+        time = float(step) if time is None else float(time)
+        if not math.isfinite(time):
+            raise InputError(f"time = {time!r} must be a finite number")
         data = {}
         if self.reference is not None:
             if len(self.reference) != n:
                 raise InputError(f"positions hold {n} nodes but the reference holds {len(self.reference)}")
-            data["displacement"] = points - self.reference
+            data[REFERENCE_ARRAY] = self.reference
         for name, values in (point_data or {}).items():
             values = np.asarray(values)
             if name in data:
@@ -129,14 +142,21 @@ class FrameWriter:
             if values.ndim not in (1, 2) or len(values) != n:
                 raise InputError(f"point array {name!r} has shape {values.shape}; expected ({n},) or ({n}, k)")
             data[name] = values
+        cells = {}
+        for name, values in (cell_data or {}).items():
+            values = np.asarray(values, dtype=float)
+            if values.ndim not in (1, 2) or len(values) != len(self.cells):
+                raise InputError(f"cell array {name!r} has shape {values.shape}; expected ({len(self.cells)},) or "
+                                 f"({len(self.cells)}, k)")
+            cells[name] = [values]
 
         name = f"{self.prefix}_{step:05d}.vtu"
-        mesh = self._meshio.Mesh(points, [(self.cell_type, self.cells)], point_data=data)
-        field = {"TimeValue": float(step), "step": step, "dL_over_L": float(dL_over_L),
+        mesh = self._meshio.Mesh(points, [(self.cell_type, self.cells)], point_data=data, cell_data=cells)
+        field = {"TimeValue": time, "step": step, "dL_over_L": float(dL_over_L),
                  "dW_over_L": float(dW_over_L), "stage": str(stage)}
         self._write_vtu(self.directory / name, mesh, field)
-        self._entries[step] = {"file": name, "dL_over_L": float(dL_over_L), "dW_over_L": float(dW_over_L),
-                               "stage": str(stage)}
+        self._entries[step] = {"file": name, "time": time, "dL_over_L": float(dL_over_L),
+                               "dW_over_L": float(dW_over_L), "stage": str(stage)}
         self._write_collection()
         return self.directory / name
 
@@ -166,12 +186,14 @@ class FrameWriter:
 
     def _write_collection(self) -> None:
         root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
-        root.append(ET.Comment(" ddg frames: timestep = recorded step index; dL_over_L, dW_over_L "
-                               "and stage are given per frame "))
+        root.append(ET.Comment(" ddg frames: timestep = the frame's time (ddg.simulate: dW/L on the shear, "
+                               "dL/L - dL_end/L on the compression); step, dL_over_L, dW_over_L and stage "
+                               "are given per frame "))
         collection = ET.SubElement(root, "Collection")
         for step in sorted(self._entries):
             entry = self._entries[step]
-            attributes = {"timestep": str(step), "group": "", "part": "0", "file": entry["file"]}
+            attributes = {"timestep": repr(entry["time"]), "step": str(step), "group": "", "part": "0",
+                          "file": entry["file"]}
             for key in ("dL_over_L", "dW_over_L"):
                 if math.isfinite(entry[key]):
                     attributes[key] = repr(entry[key])
@@ -199,12 +221,16 @@ def _field_data_xml(field: dict) -> str:
 
 
 def read_frame(path) -> tuple[np.ndarray, dict, dict]:
-    """Positions (N, 3), point arrays and metadata (step, dL_over_L, dW_over_L, stage) of one frame."""
+    """Positions (N, 3), point and cell arrays (cell arrays under "cell:<name>") and metadata
+    (step, time, dL_over_L, dW_over_L, stage) of one frame."""
     meshio = _import_meshio()
     mesh = meshio.read(path, file_format="vtu")
     field = mesh.field_data
     meta = {"step": int(field["step"][0]) if "step" in field else None,
+            "time": float(field["TimeValue"][0]) if "TimeValue" in field else math.nan,
             "dL_over_L": float(field["dL_over_L"][0]) if "dL_over_L" in field else math.nan,
             "dW_over_L": float(field["dW_over_L"][0]) if "dW_over_L" in field else math.nan,
             "stage": bytes(np.asarray(field.get("stage", []), dtype=np.uint8)).decode("utf-8")}
-    return np.asarray(mesh.points), dict(mesh.point_data), meta
+    arrays = dict(mesh.point_data)
+    arrays.update({f"cell:{name}": np.asarray(blocks[0]) for name, blocks in mesh.cell_data.items()})
+    return np.asarray(mesh.points), arrays, meta

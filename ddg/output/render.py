@@ -125,8 +125,8 @@ def _frame_files(frames_dir: Path) -> dict[int, Path]:
     files = {}
     if pvd.is_file():
         try:
-            for d in ET.parse(pvd).getroot().iter("DataSet"):
-                files[int(d.get("timestep"))] = frames_dir / d.get("file")
+            for d in ET.parse(pvd).getroot().iter("DataSet"):   # "step" (timestep is dW/L; older files: the step)
+                files[int(d.get("step") if d.get("step") is not None else d.get("timestep"))] = frames_dir / d.get("file")
         except (ET.ParseError, TypeError, ValueError):
             files = {}
     if not files:  # no collection (or a broken one): the frame files by name
@@ -257,6 +257,8 @@ def read_frame(path, *, strip_width: float | None = None) -> Frame:
     cells, kind = _cells(grid, path)
     data = {name: np.asarray(grid.point_data[name]) for name in grid.point_data.keys()}
     clamped, depth = None, 0.0
+    if "flat_position" in data and data["flat_position"].shape == points.shape:
+        data["displacement"] = points - data.pop("flat_position")   # coloured by |displacement|
     if "displacement" in data and data["displacement"].shape == points.shape:
         reference = points - data["displacement"]
         length, depth, left, right = clamp_bands(reference)

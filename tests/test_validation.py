@@ -50,6 +50,13 @@ def test_report_writes_every_figure_with_its_data(smoke_report):
     assert written["runs"] == summary["runs"] > 0
 
 
+def test_the_report_html_links_resolve_and_shows_no_markdown_source(smoke_report):
+    from test_report_html import check_page
+
+    out, _ = smoke_report
+    check_page(out)
+
+
 def test_smoke_report_evaluates_the_claims_its_runs_allow_and_fails_the_others(smoke_report):
     """The smoke profile runs rods at M = 30 and 40 only (the single-model claims are stated for
     M = 100 and for plates and ribbons), so of those it can evaluate only the FEM shell's elastica,

@@ -15,6 +15,7 @@ import importlib
 import io
 import json
 import math
+import re
 import time
 from pathlib import Path
 
@@ -63,6 +64,25 @@ def cell(value) -> str:
     return str(value)
 
 
+_CODE = re.compile(r"`([^`]+)`")
+_BOLD = re.compile(r"\*\*(.+?)\*\*")
+_LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
+_URL = re.compile(r"(?<![\"=>/])\b(https?://[^\s<)]+)")
+
+
+def inline_markdown(text):
+    """The inline Markdown the sentences and captions use (`code`, **bold**, [text](target), bare
+    http(s) URLs) as HTML, the text itself escaped first: a Markup for the autoescaped templates."""
+    from markupsafe import Markup, escape
+
+    html = str(text) if isinstance(text, Markup) else str(escape(text))
+    html = _CODE.sub(r"<code>\1</code>", html)
+    html = _BOLD.sub(r"<strong>\1</strong>", html)
+    html = _LINK.sub(r'<a href="\2">\1</a>', html)
+    html = _URL.sub(r'<a href="\1">\1</a>', html)
+    return Markup(html)
+
+
 def _environment(html: bool):
     """The Jinja2 environment of validation/templates: autoescaped for HTML, plain for Markdown."""
     try:
@@ -71,7 +91,7 @@ def _environment(html: bool):
         raise _missing_extra(["jinja2"]) from exc
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=html, trim_blocks=True,
                              lstrip_blocks=True, keep_trailing_newline=True, undefined=jinja2.StrictUndefined)
-    env.filters.update(cell=cell, frac=fraction, fmt=format)
+    env.filters.update(cell=cell, frac=fraction, fmt=format, md=inline_markdown if html else (lambda t: t))
     return env
 
 

@@ -452,7 +452,9 @@ def _frame_index(frames_dir: Path) -> list[dict]:
     pvd = frames_dir / "frames.pvd"
     if not pvd.exists():
         return []
-    return [{"step": int(d.get("timestep")), "file": frames_dir / d.get("file"), "stage": d.get("stage"),
+    # "step" (the pvd's timestep is the time, dW/L; frames written before it carried the step)
+    return [{"step": int(d.get("step") if d.get("step") is not None else d.get("timestep")),
+             "file": frames_dir / d.get("file"), "stage": d.get("stage"),
              "dW_over_L": float(d.get("dW_over_L"))} for d in ET.parse(pvd).getroot().iter("DataSet")]
 
 

@@ -95,3 +95,14 @@ def test_a_headless_browser_draws_the_snapshot(tmp_path):
                           capture_output=True, text=True, timeout=180)
     assert shot.exists() and shot.read_bytes()[:8] == PNG, done.stderr[-2000:]
     assert shot.stat().st_size > 50_000   # a drawn page, not a blank one (measured: 0.5-1 MB)
+
+
+def test_stability_map_colours_the_mesh_unresolved_outcome_as_its_own():
+    """The map's "ok (mesh unresolved near dW_max)" used to take plain "ok"'s colour (a startswith
+    test that matched the shorter category first)."""
+    from validation.figures import STABILITY_CATEGORIES, stability_category
+
+    assert STABILITY_CATEGORIES[stability_category("ok (mesh unresolved near dW_max)")] == \
+        "ok (mesh unresolved near dW_max)"
+    assert STABILITY_CATEGORIES[stability_category("ok")] == "ok"
+    assert STABILITY_CATEGORIES[stability_category("missed pitchfork (rod width error 0.2)")] == "rod width error"

@@ -49,19 +49,34 @@ def pareto(points: list[tuple[float, float]]) -> list[int]:
 
 
 # ---------------------------------------------------------------------------- one function per kind
+MARKERS = {"rod": "o", "plate": "s", "ribbon": "^", "fem": "D", "ribbon-sano-wada": "v", "ribbon-trapeze": "P",
+           "ribbon-wunderlich": "X"}
+
+
 def elastica(rows: list[dict], exact: list[tuple[float, float]]):
+    """Fig. 5b: H_mid/L against dL/L per model (its own marker) on the exact elastica, and below
+    the residual H_mid - H_elastica (errors ~1e-4 L are invisible on the curve)."""
     plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(5, 3.6))
-    ax.plot(*zip(*exact), "k-", lw=1, label="exact elastica")
+    fig, (ax, res) = plt.subplots(2, 1, figsize=(5.2, 5.2), sharex=True, gridspec_kw={"height_ratios": [2, 1.3]})
+    ex = np.array(sorted(exact))
+    ax.plot(ex[:, 0], ex[:, 1], "k-", lw=1, label="exact elastica")
     for (model, width), sel in _groups(rows, "model", "width_ratio"):
-        dl, h = [r["dL_over_L"] for r in sel], [r["H_mid_over_L"] for r in sel]
-        if model == "fem":
-            ax.plot(dl, h, "s", mfc="none", ms=5, color="k", label=f"FEM W/L={fraction(width)}")
-        else:
-            ax.plot(dl, h, "o", ms=3, color=COLORS[model], label=f"{model} W/L={fraction(width)}")
-    ax.set_xlabel("dL/L")
+        dl = np.array([r["dL_over_L"] for r in sel])
+        h = np.array([r["H_mid_over_L"] for r in sel])
+        color = COLORS.get(model, "gray")
+        marker = MARKERS.get(model, "o")
+        label = f"{'FEM' if model == 'fem' else model} W/L={fraction(width)}"
+        ax.plot(dl, h, marker, mfc="none", ms=4, color=color, label=label)
+        keep = dl > 0
+        res.plot(dl[keep], h[keep] - np.interp(dl[keep], ex[:, 0], ex[:, 1]), marker + "-", mfc="none", ms=3, lw=0.6,
+                 color=color, label=label)
+    res.axhline(0.0, color="k", lw=0.6)
+    res.set_yscale("symlog", linthresh=1e-5)
     ax.set_ylabel("H_mid/L")
+    res.set_xlabel("dL/L")
+    res.set_ylabel("H_mid - H_elastica (/L)\n(symlog, linear |.| < 1e-5)", fontsize=7)
     ax.legend(fontsize=7)
+    fig.tight_layout()
     return fig
 
 
@@ -71,12 +86,12 @@ def _shear_panel(ax, rows: list[dict], column: str, thresholds: list[dict]) -> N
         dw, y = [r["dW_over_L"] for r in sel], [r[column] for r in sel]
         if model == "fem":
             ax.plot(dw, y, "k.", ms=3, label="FEM")
-            continue
-        ax.plot(dw, y, "-", color=COLORS[model], label=model)
+        else:
+            ax.plot(dw, y, "-", color=COLORS.get(model, "gray"), label=model)
         for t in (t for t in thresholds if t["model"] == model):
             for key, style in (("dW1_over_L", ":"), ("dW2_over_L", "--")):
                 if t[key] is not None:
-                    ax.axvline(t[key], color=COLORS[model], ls=style, lw=0.8)
+                    ax.axvline(t[key], color=COLORS.get(model, "gray"), ls=style, lw=0.8)
 
 
 def _panel_grid(plt, count: int, cols: int, size: tuple[float, float]):
@@ -100,11 +115,21 @@ def shear_curves(rows: list[dict], panels: list[tuple[float, float]], thresholds
             ax.plot([p["value"]], [0.0], "v" if p["key"] == "dW1" else "^", color="crimson", ms=7,
                     label=f"paper {p['key']}")
         ax.set_title(f"W/L = {fraction(width)}, dL/L = {fraction(compression)}", fontsize=9)
-        ax.set_xlabel("dW/L")
+        ax.set_xlabel("dW/L (dotted: dW1, dashed: dW2 of the model in its colour)", fontsize=7)
         ax.set_ylabel("H_mid/L")
-        ax.legend(fontsize=6)
+        _legend(ax)
     fig.tight_layout()
     return fig
+
+
+def _legend(ax, size: float = 6.5) -> None:
+    """One entry per label (the threshold lines repeat them), outside the data where it fits."""
+    handles, labels = ax.get_legend_handles_labels()
+    seen = {}
+    for h, label in zip(handles, labels):
+        seen.setdefault(label, h)
+    if seen:
+        ax.legend(list(seen.values()), list(seen), fontsize=size, framealpha=0.85, loc="best")
 
 
 def shear_force(rows: list[dict], panels: list[tuple[float, float]], thresholds: list[dict]):
@@ -115,8 +140,8 @@ def shear_force(rows: list[dict], panels: list[tuple[float, float]], thresholds:
         ax.set_yscale("symlog", linthresh=1.0)
         ax.set_title(f"W/L = {fraction(width)}, dL/L = {fraction(compression)}", fontsize=9)
         ax.set_xlabel("dW/L")
-        ax.set_ylabel("F_shear L/(E b^3)")
-        ax.legend(fontsize=7)
+        ax.set_ylabel("F_shear L/(E b^3)\n(symlog: linear for |F| < 1, log beyond)", fontsize=8)
+        _legend(ax, 7)
     fig.tight_layout()
     return fig
 
@@ -131,14 +156,37 @@ def thresholds(rows: list[dict], compressions: list[float], dW_max: dict, paper:
                 pts = [(r["width_ratio"], r[key]) for r in sel if r[key] is not None]
                 if pts:
                     ax.plot(*zip(*pts), marker, color=COLORS[model], ms=4, label=f"{model} {key[:3]}")
-        for p in (p for p in paper if p["compression_ratio"] == compression):
-            ax.plot([p["width_ratio"]], [p["value"]], "v" if p["key"] == "dW1" else "^", color="crimson", ms=7)
-        ax.set_title(f"dL/L = {fraction(compression)} (red: paper)", fontsize=9)
+        _shade_phases(ax, [r for r in rows if r["compression_ratio"] == compression], dW_max[compression])
+        for k, p in enumerate(p for p in paper if p["compression_ratio"] == compression):
+            ax.plot([p["width_ratio"]], [p["value"]], "v" if p["key"] == "dW1" else "^", color="crimson", ms=7,
+                    label=f"paper {p['key']} (Fig. 8)")
+        ax.set_title(f"dL/L = {fraction(compression)}", fontsize=9)
         ax.set_xlabel("W/L")
         ax.set_ylabel("threshold dW/L")
-        ax.legend(fontsize=6)
+        _legend(ax, 6)
     fig.tight_layout()
     return fig
+
+
+PHASE_SHADES = (("U", "#e8f0ff"), ("US", "#fff3d6"), ("S", "#e6f6e6"))
+
+
+def _shade_phases(ax, rows: list[dict], dw_max: list[tuple[float, float]]) -> None:
+    """U below dW1, US between dW1 and dW2, S between dW2 and dW_max, from the reference's
+    thresholds (the FEM's where the rows have it, else the plate's), shaded and labelled."""
+    for model in ("fem", "fem (extrapolated)", "plate"):
+        sel = sorted((r for r in rows if r["model"] == model and r["dW1_over_L"] is not None),
+                     key=lambda r: r["width_ratio"])
+        if len(sel) >= 2:
+            break
+    else:
+        return
+    w = np.array([r["width_ratio"] for r in sel])
+    d1 = np.array([r["dW1_over_L"] for r in sel])
+    top = np.interp(w, *map(np.array, zip(*sorted(dw_max))))
+    d2 = np.array([r["dW2_over_L"] if r["dW2_over_L"] is not None else t for r, t in zip(sel, top)])
+    for (name, colour), (lo, hi) in zip(PHASE_SHADES, ((np.zeros_like(d1), d1), (d1, d2), (d2, top))):
+        ax.fill_between(w, lo, hi, color=colour, zorder=0, label=f"{name} ({'FEM' if model.startswith('fem') else model})")
 
 
 def wide_ribbons(rows: list[dict], compressions: list[float]):
@@ -173,13 +221,31 @@ def convergence(rows: list[dict]):
         if pts:
             axes[1].loglog(*zip(*pts), "o-", color=COLORS[model], label=model)
     axes[0].set_xlabel("resolution (rod nodes M / plate triangles)")
-    axes[0].set_ylabel("|H_mid / H_elastica - 1| after compression")
-    axes[1].set_xlabel("resolution")
-    axes[1].set_ylabel("max |H_mid(dW) - finest| / L")
+    axes[0].set_ylabel("|H_mid / H_elastica - 1|\nafter compression", fontsize=8)
+    axes[1].set_xlabel("resolution (rod nodes M / plate triangles)")
+    axes[1].set_ylabel("max |H_mid(dW) - finest| / L", fontsize=8)
     for ax in axes:
-        ax.legend(fontsize=7)
+        _slope_guides(ax)
+        _legend(ax, 7)
     fig.tight_layout()
     return fig
+
+
+def _slope_guides(ax) -> None:
+    """Dashed lines of slope -1 and -2 (error ~ N^-1, N^-2) through the upper right of the data."""
+    lines = [line for line in ax.get_lines() if len(line.get_xdata())]
+    if not lines:
+        return
+    x = np.concatenate([np.asarray(line.get_xdata(), float) for line in lines])
+    y = np.concatenate([np.asarray(line.get_ydata(), float) for line in lines])
+    ok = (x > 0) & (y > 0)
+    if ok.sum() < 2:
+        return
+    x0, x1 = np.min(x[ok]), np.max(x[ok])
+    y0 = np.max(y[ok])
+    for order, style in ((1, (0, (4, 3))), (2, (0, (1, 2)))):
+        xs = np.array([x0, x1])
+        ax.plot(xs, y0 * (xs / x0) ** (-order), color="0.5", ls=style, lw=0.8, label=f"slope -{order}")
 
 
 def poisson(rows: list[dict]):
@@ -201,9 +267,11 @@ def speed_accuracy(rows: list[dict], reference: str):
         pts = [(d["wall_time_s"], d[key], d) for d in rows if d[key] and d["wall_time_s"]]
         for model in sorted({p[2]["model"] for p in pts}):
             sel = sorted((p for p in pts if p[2]["model"] == model), key=lambda p: p[2]["resolution"])
-            ax.loglog([p[0] for p in sel], [p[1] for p in sel], "o-", color=COLORS[model], label=model)
-            for p in sel:
-                ax.annotate(str(p[2]["resolution"]), (p[0], p[1]), fontsize=6)
+            ax.loglog([p[0] for p in sel], [p[1] for p in sel], MARKERS.get(model, "o") + "-",
+                      color=COLORS.get(model, "gray"), label=model)
+            for k, p in enumerate(sel):   # alternate above / below the point so neighbours do not overlap
+                ax.annotate(str(p[2]["resolution"]), (p[0], p[1]), xytext=(4, 5 if k % 2 == 0 else -9),
+                            textcoords="offset points", fontsize=6, color=COLORS.get(model, "gray"))
         front = pareto([(p[0], p[1]) for p in pts])
         if front:
             fp = sorted((pts[i][0], pts[i][1]) for i in front)
@@ -211,7 +279,8 @@ def speed_accuracy(rows: list[dict], reference: str):
         ax.set_xlabel("wall time of the full path (s)")
         ax.set_ylabel(label)
         ax.legend(fontsize=7)
-    fig.suptitle(f"W/L = 1/6, dL/L = 1/2; reference: {reference}", fontsize=8)
+    fig.suptitle(f"W/L = 1/6, dL/L = 1/2; reference: {reference}\nwall times as measured by the report's runs "
+                 "(labels: resolution; see the caption for the load on the machine)", fontsize=8)
     fig.tight_layout()
     return fig
 
@@ -219,14 +288,17 @@ def speed_accuracy(rows: list[dict], reference: str):
 def stability_map(rows: list[dict]):
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=(7, 3.6))
+    placed: dict[tuple, int] = {}
     for entry in rows:
-        cat = next((i for i, c in enumerate(STABILITY_CATEGORIES) if entry["outcome"].startswith(c)), 0)
-        if "width error" in entry["outcome"]:
-            cat = STABILITY_CATEGORIES.index("rod width error")
+        cat = stability_category(entry["outcome"])
         row = {"rod": 0, "plate": 1, "ribbon": 2}.get(entry["model"], 3)
         y = row + (0.25 if entry["compression_ratio"] == 0.25 else 0)
-        ax.scatter(entry["width_ratio"], y, c=STABILITY_COLORS[cat],
-                   s=30 + 40 * (entry["reached_percent_of_dW_max"] or 0) / 100)
+        key = (round(float(entry["width_ratio"]), 6), y)
+        shift = placed.get(key, 0)     # several runs of one scene (resolutions): side by side
+        placed[key] = shift + 1
+        x = float(entry["width_ratio"]) * (1.0 + 0.06 * shift)
+        ax.scatter(x, y + 0.07 * shift, c=STABILITY_COLORS[cat], edgecolors="k", linewidths=0.4, alpha=0.85,
+                   s=25 + 35 * (entry["reached_percent_of_dW_max"] or 0) / 100, zorder=3)
     for c, col in zip(STABILITY_CATEGORIES, STABILITY_COLORS):
         ax.scatter([], [], c=col, label=c)
     ax.set_yticks([0, 1, 2])
@@ -234,6 +306,15 @@ def stability_map(rows: list[dict]):
     ax.set_xlabel("W/L (upper row of each model: dL/L = 1/4)")
     ax.legend(fontsize=6, loc="upper right")
     return fig
+
+
+def stability_category(outcome: str) -> int:
+    """Index in STABILITY_CATEGORIES of an outcome: the longest category it starts with ("ok (mesh
+    unresolved near dW_max)" is not plain "ok"); an outcome naming the rod's width error is that."""
+    if "width error" in outcome:
+        return STABILITY_CATEGORIES.index("rod width error")
+    matches = [i for i, c in enumerate(STABILITY_CATEGORIES) if outcome.startswith(c)]
+    return max(matches, key=lambda i: len(STABILITY_CATEGORIES[i]), default=0)
 
 
 def snapshots(rows: list[dict], panels: list[dict]):

@@ -106,3 +106,28 @@ def test_stability_map_colours_the_mesh_unresolved_outcome_as_its_own():
         "ok (mesh unresolved near dW_max)"
     assert STABILITY_CATEGORIES[stability_category("ok")] == "ok"
     assert STABILITY_CATEGORIES[stability_category("missed pitchfork (rod width error 0.2)")] == "rod width error"
+
+
+def test_the_paper_figures_draw_from_their_data(tmp_path):
+    """Figs. 10 and A.12-14 from the files data/paper_figures/generate.sh writes (tiny hand-made ones
+    here): the centreline error on a log L/W axis, the curvature profiles per dW/L."""
+    pytest.importorskip("matplotlib")
+    from validation import figures
+    from validation.report_data import paper_figures
+
+    (tmp_path / "centerline_error").mkdir()
+    (tmp_path / "centerline_error" / "centerline_error.csv").write_text(
+        "L_over_W,W_over_L,dW_over_L,mean_error,max_error,rod_edge_mean_error,ribbon_edge_mean_error,phase,"
+        "triangles,message\n2,0.5,0.1,0.01,0.02,0,0,U,2000,\n20,0.05,0.1,0.0001,0.0003,0,0,U,2000,\n")
+    for model in ("rod", "plate"):
+        (tmp_path / f"curvatures_{model}").mkdir()
+        (tmp_path / f"curvatures_{model}" / "curvatures.csv").write_text(
+            "model,step,dL_over_L,dW_over_L,s_over_L,k1_L,k2_L,tau_L\n"
+            + "".join(f"{model},0,0.5,0.2,{s},0.0,{s * 3},{-s}\n" for s in (0.1, 0.5, 0.9)))
+    found = {f.name: f for f in paper_figures(tmp_path)}
+    assert set(found) == {"centerline_error", "curvature_profiles"}
+    fig = figures.draw(found["centerline_error"])
+    assert fig.axes[0].get_xscale() == "log"
+    png = figures.save(figures.draw(found["curvature_profiles"]), tmp_path / "out", "curvature_profiles")
+    assert png[:8] == PNG and (tmp_path / "out" / "curvature_profiles.pdf").exists()
+    assert paper_figures(tmp_path / "none") == []

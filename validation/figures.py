@@ -370,7 +370,52 @@ def _rendered_snapshots(panels: list[dict], widths: list[float], cols: int):
         return None
 
 
-DRAW = {"elastica": elastica, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
+def centerline_error(rows: list[dict]):
+    """Fig. 10: mean (solid) and largest (dotted) delta of Eq. (13) in % of L against L/W (log axis),
+    one colour per dW/L."""
+    plt = _pyplot()
+    fig, ax = plt.subplots(figsize=(5.4, 3.8))
+    for k, ((shear,), sel) in enumerate(sorted(_groups(rows, "dW_over_L"))):
+        sel = sorted((r for r in sel if isinstance(r["mean_error"], float) and np.isfinite(r["mean_error"])),
+                     key=lambda r: r["L_over_W"])
+        if not sel:
+            continue
+        colour = f"C{k}"
+        x = [r["L_over_W"] for r in sel]
+        ax.plot(x, [100 * r["mean_error"] for r in sel], "o-", color=colour, label=f"dW/L = {shear:g}, mean")
+        ax.plot(x, [100 * r["max_error"] for r in sel], "^:", color=colour, label=f"dW/L = {shear:g}, max")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("L / W (log scale)")
+    ax.set_ylabel("delta (% of L), Eq. (13) (log scale)")
+    _legend(ax, 6.5)
+    fig.tight_layout()
+    return fig
+
+
+def curvature_profiles(rows: list[dict]):
+    """Figs. A.12-14: k1 L, k2 L, tau L against s/L, a row per curvature, a column per dW/L, a
+    line per model."""
+    plt = _pyplot()
+    shears = sorted({round(float(r["dW_over_L"]), 6) for r in rows})
+    names = (("k1_L", "k1 L (geodesic)"), ("k2_L", "k2 L (normal)"), ("tau_L", "tau L (twist)"))
+    fig, axes = plt.subplots(3, len(shears), figsize=(3.6 * len(shears), 6.6), squeeze=False, sharex=True)
+    for j, shear in enumerate(shears):
+        for (model,), sel in _groups([r for r in rows if abs(float(r["dW_over_L"]) - shear) < 1e-9], "model"):
+            sel = sorted(sel, key=lambda r: r["s_over_L"])
+            for i, (key, _) in enumerate(names):
+                axes[i][j].plot([r["s_over_L"] for r in sel], [r[key] for r in sel], MARKERS.get(model, "o") + "-",
+                                ms=2, lw=0.8, color=COLORS.get(model, "gray"), label=model)
+        axes[0][j].set_title(f"dW/L = {shear:g}", fontsize=9)
+        axes[-1][j].set_xlabel("s/L")
+    for i, (_, label) in enumerate(names):
+        axes[i][0].set_ylabel(label, fontsize=8)
+    _legend(axes[0][0], 6.5)
+    fig.tight_layout()
+    return fig
+
+
+DRAW = {"elastica": elastica, "centerline_error": centerline_error, "curvature_profiles": curvature_profiles, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
         "convergence": convergence, "poisson": poisson, "speed_accuracy": speed_accuracy,
         "stability_map": stability_map, "snapshots": snapshots, "wide_ribbons": wide_ribbons}
 

@@ -591,6 +591,50 @@ def error_map_rows(path: Path | None = None) -> list[dict]:
     return read_table(path) if path.exists() else []
 
 
+def _numeric_csv(path: Path) -> list[dict]:
+    import csv
+
+    def number(v):
+        try:
+            return float(v)
+        except (TypeError, ValueError):
+            return v
+
+    with open(path, newline="") as fh:
+        return [{k: number(v) for k, v in row.items()} for row in csv.DictReader(fh)]
+
+
+def paper_figures(folder: Path | None = None) -> list[FigureData]:
+    """The figures after the paper's Fig. 10 (the centreline approximation, Eq. 13) and Figs.
+    A.12-14 (curvature profiles) from their committed data (data/paper_figures/generate.sh); the
+    ones whose data are missing are left out."""
+    from .reference import ROOT
+
+    folder = Path(folder) if folder is not None else ROOT / "data" / "paper_figures"
+    out = []
+    errors = folder / "centerline_error" / "centerline_error.csv"
+    if errors.exists():
+        rows = [{k: r[k] for k in ("L_over_W", "W_over_L", "dW_over_L", "mean_error", "max_error", "phase")}
+                for r in _numeric_csv(errors)]
+        out.append(_records_figure(
+            "centerline_error", "centerline_error",
+            "The plate's centreline against the best centreline of a rod (paper Fig. 10, Eq. 13): mean and largest "
+            "deviation delta in % of L against L/W on a log axis (L/W = 20 at the right), one line per dW/L; "
+            "plate on 2000 triangles, dL/L = 1/2 (`python -m ddg centerline-error`, data/paper_figures).", rows))
+    profiles = []
+    for model in ("rod", "ribbon", "plate"):
+        path = folder / f"curvatures_{model}" / "curvatures.csv"
+        if path.exists():
+            profiles += _numeric_csv(path)
+    if profiles:
+        out.append(_records_figure(
+            "curvature_profiles", "curvature_profiles",
+            "Curvature profiles along the strip (paper Figs. A.12-14): geodesic k1, normal k2 and twist tau (times "
+            "L) of the rod, the Sadowsky ribbon and the plate's centreline at W/L = 1/20, dL/L = 1/2, one column per "
+            "dW/L (`python -m ddg curvatures`, data/paper_figures).", profiles))
+    return out
+
+
 def _paper_scene(row: dict) -> tuple[float, float] | None:
     """(dL/L, W/L) of a map row on one of the paper's ten scenes at the paper's strip, else None."""
     from ddg.geometry.strip import Strip
@@ -787,6 +831,7 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
         tables["wide_ribbons"] = Table("wide_ribbons", WIDE_COLUMNS, wide, csv=True)
         tables["enough"] = Table("enough", ENOUGH_COLUMNS, enough_table(map_rows), csv=True)
         figures.append(wide_ribbon_figure(wide))
+    figures += paper_figures()
     provenance = Provenance(profile.name, len(results), len(set(all_specs)), len(all_specs),
                             sorted(golds), sorted(scene for scene in scenes if scene not in golds))
     timings = Timings(sum(float(r.summary.get("wall_time_s") or 0.0) for r in results.values()))

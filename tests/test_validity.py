@@ -59,7 +59,7 @@ def test_width_warnings_follow_the_map(tmp_path):
     assert len(outside) == 1 and "outside the error map" in outside[0] and "L/b = 4000" in outside[0]
     assert width_warnings(summary("rod", 0.3), error_map=tmp_path / "none.csv") == []   # no such map: no check
     ribbon = width_warnings(summary("ribbon", 0.05))
-    assert len(ribbon) == 1 and "has no dW1 of this model" in ribbon[0]
+    assert len(ribbon) == 1 and "has no dW1 bound of this model" in ribbon[0] and "not located" in ribbon[0]
 
 
 def test_missing_map_file_means_no_width_check(tmp_path, monkeypatch):

@@ -115,6 +115,12 @@ def threshold_warnings(summary: dict, rows: list[dict]) -> list[str]:
     return out
 
 
+def _short(reason: str, limit: int = 160) -> str:
+    """The first clause of a map row's reason (they list every missing quantity), at most `limit` characters."""
+    first = reason.split("; ")[0].split(" (")[0]
+    return first if len(first) <= limit else first[: limit - 3] + "..."
+
+
 def width_warnings(summary: dict, error_map=None) -> list[str]:
     """A 1D model on a scene where the error map says it misses the width (module docstring)."""
     model = summary.get("model")
@@ -149,9 +155,10 @@ def width_warnings(summary: dict, error_map=None) -> list[str]:
     names = ", ".join(s.name for s in basis)
     values = [(p.errors["dW1"], p.label) for p in found if p.errors.get("dW1") is not None]
     if not values:
-        reasons = "; ".join(dict.fromkeys(p.why.get("dW1", "no row") for p in found)) or f"no row of {model}"
-        return [f"{where}: the error map has no dW1 of this model on the scene(s) {names} ({reasons}), where the "
-                "shell has one: it misses the width effect here; use --model plate or --model auto --tolerance"]
+        reasons = "; ".join(dict.fromkeys(_short(p.why.get("dW1", "no row")) for p in found)) or f"no row of {model}"
+        return [f"{where}: the error map has no dW1 bound of this model on the scene(s) {names} ({reasons}), where "
+                "the shell has a dW1: its width error is not measured here; use --model plate or --model auto "
+                "--tolerance"]
     best, label = min(values)
     if best <= WIDTH_TOLERANCE:
         return []

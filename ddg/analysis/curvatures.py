@@ -24,6 +24,7 @@ from ..energies.rod_curvature import material_curvatures
 from ..geometry.frames import cross, reference_twist, rowdot, unit
 from ..geometry.strip import InputError
 from ..output.io import atomic_write_text
+from .rod_strains import rod_curvatures  # noqa: F401  (re-exported: the rod's profile)
 
 CURVATURE_COLUMNS = ("model", "step", "dL_over_L", "dW_over_L", "s_over_L", "k1_L", "k2_L", "tau_L")
 
@@ -35,20 +36,6 @@ def framed_curve_curvatures(x: np.ndarray, m1: np.ndarray):
     m2 = cross(t, m1)
     kappa_n, kappa_g = material_curvatures(x, m1, m2)
     return kappa_g, kappa_n, reference_twist(m1, t)
-
-
-def rod_curvatures(model, q: np.ndarray) -> dict:
-    """Curvatures of the rod or ribbon at q (frames transported from the model's committed state):
-    s/L of the interior nodes and k1 L (geodesic), k2 L (bending), tau L (twist)."""
-    x = model.positions(q)
-    _, _, m1, m2, m_ref = model.frames(q)
-    kappa_n, kappa_g = material_curvatures(x, m1, m2)
-    theta = q[model.theta_dofs]
-    tau = theta[1:] - theta[:-1] + m_ref
-    L = model.strip.length
-    scale = L / model.voronoi_lengths
-    return {"s_over_L": model.centerline.node_arclength[1:-1] / L, "k1_L": kappa_g * scale, "k2_L": kappa_n * scale,
-            "tau_L": tau * scale}
 
 
 def plate_vertex_normals(model, q: np.ndarray) -> np.ndarray:

@@ -89,7 +89,7 @@ def _plate_content(model, q):
 
 
 def _rod_content(model, q):
-    from ..analysis.curvatures import rod_curvatures
+    from ..analysis.rod_strains import rod_curvatures
 
     x = model.positions(q)
     _, _, _, m2, _ = model.frames(q)

@@ -738,9 +738,21 @@ def missing_scenes(scenes: list[ReferenceScene]) -> list[str]:
         elif not any(m.model == "plate" for m in s.stored):
             out.append(f"{s.name}: no stored plate study")
     lbs = sorted({round(s.actual_slenderness) for s in scenes if s.reference is not None})
-    out.append(f"L/b: FEM references exist at L/b = {', '.join(str(v) for v in lbs)} only; issue 17 asks for L/b "
-               "4000 too (no FEM reference: not launched, the cores are taken), and L/b other than the paper's at "
-               "W/L > 1/20 has none")
+    out.append(f"L/b: FEM references exist at L/b = {', '.join(str(v) for v in lbs)}; L/b other than the paper's "
+               "at W/L > 1/20 has none")
+    thin = [s for s in scenes if s.reference is not None and s.actual_slenderness > 2000]
+    for s in thin:
+        stops = {}
+        for m in s.stored:
+            summary = finished_run_summary(m.folder) or {}
+            if summary.get("status") == "stopped":
+                shear = [r for r in StoredRun(m.folder).rows if r["stage"] == "shear"]
+                stops.setdefault(m.model, []).append(f"{m.label} at dW/L = {shear[-1]['dW_over_L']:.4f}"
+                                                     if shear else m.label)
+        if stops:
+            out.append(f"{s.name}: stopped runs, at the fold of US where the stable path should snap to S: "
+                       + "; ".join(f"{model} {', '.join(v)}" for model, v in stops.items())
+                       + ". The reference there has dW1 and H_mid up to the fold but no dW2")
     midedge = sorted({s.name for s in scenes for m in s.stored if m.model == "plate-midedge"})
     out.append(f"the mid-edge plate has stored runs on {len(midedge)} scenes only ({', '.join(midedge) or 'none'})")
     out.append("data/fem_fine and data/fem_convergence are other meshes of dL0.5_W0.1667 and data/fem_dep another "

@@ -84,11 +84,19 @@ def _shear_panel(ax, rows: list[dict], column: str, thresholds: list[dict]) -> N
     """`column` against dW/L per model (FEM as points), each model's dW1 (dotted) and dW2 (dashed)."""
     for (model,), sel in _groups(rows, "model"):
         dw, y = [r["dW_over_L"] for r in sel], [r[column] for r in sel]
+        mine = [t for t in thresholds if t["model"] == model]
+        resolved = next((t.get("resolved_up_to_dW_over_L") for t in mine if t.get("resolved_up_to_dW_over_L")), None)
         if model == "fem":
             ax.plot(dw, y, "k.", ms=3, label="FEM")
-        else:
+        elif resolved is None or resolved >= max(dw) - 1e-12:
             ax.plot(dw, y, "-", color=COLORS.get(model, "gray"), label=model)
-        for t in (t for t in thresholds if t["model"] == model):
+        else:   # past the last state the mesh resolves: thin and faint, with its own legend entry
+            dw, y = np.asarray(dw), np.asarray(y)
+            inside = dw <= resolved + 1e-12
+            ax.plot(dw[inside], y[inside], "-", color=COLORS.get(model, "gray"), label=model)
+            ax.plot(dw[~inside], y[~inside], "-", lw=0.7, alpha=0.45, color=COLORS.get(model, "gray"),
+                    label=f"{model} past its mesh's resolution")
+        for t in mine:
             for key, style in (("dW1_over_L", ":"), ("dW2_over_L", "--")):
                 if t[key] is not None:
                     ax.axvline(t[key], color=COLORS.get(model, "gray"), ls=style, lw=0.8)

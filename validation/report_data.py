@@ -31,7 +31,7 @@ CLAIM_COLUMNS = ["claim", "statement", "bound", "measured", "holds", "reason", "
                  "in_error_bars", "needs"]
 THRESHOLD_COLUMNS = ["model", "compression_ratio", "width_ratio", "dW1_over_L", "paper_dW1", "dW1_rel_diff_vs_paper",
                      "dW2_over_L", "paper_dW2", "dW2_rel_diff_vs_paper", "dW2_S_stable_over_L",
-                     "dW1_drop_vs_W_1_20_percent", "paper_drop_percent", "dW_max_over_L"]
+                     "dW1_drop_vs_W_1_20_percent", "paper_drop_percent", "dW_max_over_L", "resolved_up_to_dW_over_L"]
 
 
 def fraction(x: float) -> str:
@@ -209,9 +209,9 @@ def shear_column(results, profile, golds, compression, width, column) -> tuple[l
         if run is None:
             continue
         dw, y = _shear(run, "dW_over_L"), _shear(run, column)
-        if model != "fem":
-            thresholds.append({"model": model, "compression_ratio": compression, "width_ratio": width,
-                               **{k: run.summary.get(k) for k in ("dW1_over_L", "dW2_over_L")}})
+        thresholds.append({"model": model, "compression_ratio": compression, "width_ratio": width,
+                           **{k: (getattr(run, "summary", None) or {}).get(k)
+                              for k in ("dW1_over_L", "dW2_over_L", "resolved_up_to_dW_over_L")}})
         rows += [[model, compression, width, a, b] for a, b in zip(dw, y)]
     return rows, thresholds
 
@@ -233,7 +233,8 @@ def shear_curve_figures(results, profile, golds) -> list[FigureData]:
         figures.append(FigureData(
             f"hmid_vs_dW_dL{compression:g}", "shear_curves",
             f"H_mid/L against dW/L at dL/L = {fraction(compression)} (paper Figs. 6, 7); dotted: dW1, dashed: "
-            "dW2 of each model (from stability); red triangles: the paper's quoted thresholds.",
+            "dW2 of each model (from stability; the FEM's in black); red triangles: the paper's quoted thresholds; "
+            "a model's curve past the last state its mesh resolves (turns above 30 degrees) is drawn faint.",
             ["model", "compression_ratio", "width_ratio", "dW_over_L", "H_mid_over_L"], rows,
             {"panels": [(compression, w) for w in scenes], "thresholds": thresholds, "paper": paper}))
     return figures
@@ -275,7 +276,8 @@ def threshold_table(results, profile, golds) -> list[dict]:
                 row = {"model": model, "compression_ratio": compression, "width_ratio": width,
                        "dW1_over_L": s.get("dW1_over_L"), "dW2_over_L": s.get("dW2_over_L"),
                        "dW2_S_stable_over_L": s.get("dW2_S_stable_over_L"),
-                       "dW_max_over_L": shear_limit(1.0, width, compression)}
+                       "dW_max_over_L": shear_limit(1.0, width, compression),
+                       "resolved_up_to_dW_over_L": s.get("resolved_up_to_dW_over_L")}
                 for key in ("dW1", "dW2"):
                     paper = paper_value(compression, width, key)
                     row[f"paper_{key}"] = paper

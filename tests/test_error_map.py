@@ -146,8 +146,8 @@ def test_committed_map_covers_every_scene_with_a_reference():
     scenes = {r["scene"] for r in rows}
     expected = {s.name for s in em.reference_scenes() if s.reference is not None and s.role == "fit"}
     assert expected <= scenes, sorted(expected - scenes)
-    # the ten benchmark scenes, W/L = 1/20 at L/b = 300 and 100, and W/L = 1/6 at L/b = 300
-    assert len(expected) == 13
+    # the ten benchmark scenes, W/L = 1/20 at L/b = 300, 100 and 4000, and W/L = 1/6 at L/b = 300
+    assert len(expected) == 14 and "dL0.5_W0.05_Lb4000" in expected
     for s in scenes:
         models = {r["model"] for r in rows if r["scene"] == s}
         assert {"rod", "plate", "fem"} <= models, (s, models)
@@ -156,35 +156,49 @@ def test_committed_map_covers_every_scene_with_a_reference():
             assert r["reason"], r
 
 
-#: The held-out scenes of the committed map (fem_reference.gold.MAP_SCENES with a finished study).
-HELD_OUT = {"dL0.5_W0.125_Lb1181", "dL0.25_W0.125_Lb787", "dL0.5_W0.25_Lb1181"}
+#: The held-out scenes of the committed map (fem_reference.gold.MAP_SCENES with a finished study): the
+#: first set, seen when rule v2 (the cross-validated margin) was made, and the second, whose FEM
+#: references were computed after it was fixed.
+HELD_OUT = set(em.HELD_OUT_FIRST) | set(em.HELD_OUT_SECOND)
 
 
 def test_committed_map_held_out_check():
     """Leave-one-scene-out and held out: the committed map's scenes bracketed by the others are the
-    interior widths at each compression (W/L = 1/6 at dL/L = 1/2 now lies at the map's L/b edge:
-    the map has it at L/b = 300 and 1181), the narrow strip at L/b = 300 and the three held-out
-    scenes (the README reports the figures)."""
+    interior widths at each compression (W/L = 1/6 at dL/L = 1/2 lies at the map's L/b edge: the map
+    has it at L/b = 300 and 1181), W/L = 1/20 at L/b = 300 (between 100 and 1181) and 1181 (between
+    300 and 4000), and the six held-out scenes (the README reports the figures)."""
     rows = committed_rows()
     entries = em.held_out_check(rows, 0.01)
     held = [e for e in entries if e["held_out"]]
     assert {e["scene"] for e in held} == {"dL0.5_W0.08333_Lb1181", "dL0.5_W0.3333_Lb1181", "dL0.25_W0.08333_Lb787",
-                                          "dL0.25_W0.1667_Lb787", "dL0.25_W0.3333_Lb787", "dL0.5_W0.05_Lb300"} | HELD_OUT
-    assert len(held) >= 3 and all(e["compared"] > 0 for e in held)
+                                          "dL0.25_W0.1667_Lb787", "dL0.25_W0.3333_Lb787", "dL0.5_W0.05_Lb300",
+                                          "dL0.5_W0.05_Lb1181"} | HELD_OUT
+    assert all(e["compared"] > 0 for e in held)
+
+
+def _held_out_entries(names):
+    entries = {e["scene"]: e for e in em.held_out_check(committed_rows(), 0.01)}
+    return [entries[name] for name in names if entries.get(name, {}).get("held_out")]
+
+
+def test_the_predicted_error_holds_on_three_held_out_scenes_made_after_the_rule():
+    """Issue 17's acceptance, on the second held-out set (W/L = 1/10 at both compressions, 1/4 at
+    dL/L = 1/4), whose references did not exist when rule v2 was fixed: every (candidate, quantity)
+    prediction bounds the error measured there. Measured: 54 of 54 (rule v1 would hold 46)."""
+    checked = _held_out_entries(em.HELD_OUT_SECOND)
+    assert len(checked) == 3
+    assert all(e["held"] == e["compared"] > 0 for e in checked), [(e["scene"], e["held"], e["compared"]) for e in checked]
+    assert all(e["margin"] > 1.0 for e in checked)   # the cross-validated margin is in use
 
 
 @pytest.mark.xfail(strict=True, reason=(
-    "issue 17 acceptance not met: on the three held-out scenes 45 of 56 (candidate, quantity) predictions hold; "
-    "11 of 20 at dL/L = 1/2, W/L = 1/8 (plate R8 dW1 measured 0.0337 > predicted 0.0197, plate R12 dW1 0.0165 > "
-    "0.0154, ribbon-trapeze M101 H_mid 0.1787 > 0.1410, the Sadowsky and Sano-Wada H_mid by 0.02: errors not "
-    "monotone in W/L, which the bracketing rule assumes); 18 of 20 at dL/L = 1/4, W/L = 1/8 (plate R8 and R12 "
-    "dW1 by 1e-4 and 3e-4); 16 of 16 at dL/L = 1/2, W/L = 1/4"))
-def test_the_predicted_error_holds_on_the_held_out_scenes():
-    """Every prediction made for a held-out scene from the fitting scenes bounds the error
-    measured there, on at least three held-out scenes (the rule was fixed before they existed)."""
-    entries = {e["scene"]: e for e in em.held_out_check(committed_rows(), 0.01)}
-    checked = [entries[name] for name in HELD_OUT if entries.get(name, {}).get("held_out")]
-    assert len(checked) >= 3
+    "not every prediction holds on the first held-out set (seen before rule v2 was made): 55 of 56; at dL/L = 1/2, "
+    "W/L = 1/8 the plate on 8 rows has dW1 error + bar 0.0337 against 0.0288 predicted (0.0197 from the bracketing "
+    "scenes times the margin 1.459). Errors are not monotone in W/L there"))
+def test_the_predicted_error_holds_on_every_held_out_scene():
+    """Every prediction made for any held-out scene from the fitting scenes bounds the error measured there."""
+    checked = _held_out_entries(sorted(HELD_OUT))
+    assert len(checked) == 6
     assert all(e["held"] == e["compared"] for e in checked), [(e["scene"], e["held"], e["compared"]) for e in checked]
 
 

@@ -34,7 +34,7 @@ def test_the_rod_on_a_wide_strip_is_told_it_misses_the_width(monkeypatch, tmp_pa
     this scene: the rod's dW1 error + reference bar 0.195 at its best resolution."""
     monkeypatch.delenv("DDG_ERROR_MAP", raising=False)
     result, raised = _run(0.5, thresholds=False)
-    width = [w for w in result.summary["warnings"] if "misses the width effect" in w]
+    width = [w for w in result.summary["warnings"] if "does not show this 1D model" in w]
     assert len(width) == 1 and "rod at W/L = 0.5" in width[0] and "0.19" in width[0]
     assert width[0] in raised
     # the command line prints it once (the Python warning is silenced there), and stores it
@@ -42,8 +42,8 @@ def test_the_rod_on_a_wide_strip_is_told_it_misses_the_width(monkeypatch, tmp_pa
     code = main(["simulate", "--model", "rod", "--width-ratio", "0.5", "--no-thresholds", "--no-branches",
                  "--out", str(out), "--quiet"])
     err = capsys.readouterr().err
-    assert code == 0 and err.count("misses the width effect") == 1 and "ValidityWarning" not in err
-    assert any("misses the width effect" in w for w in json.loads((out / "summary.json").read_text())["warnings"])
+    assert code == 0 and err.count("does not show this 1D model") == 1 and "ValidityWarning" not in err
+    assert any("does not show this 1D model" in w for w in json.loads((out / "summary.json").read_text())["warnings"])
 
 
 def test_width_warnings_follow_the_map(tmp_path):
@@ -55,8 +55,11 @@ def test_width_warnings_follow_the_map(tmp_path):
     assert width_warnings(summary("rod", 0.02)) == []
     assert width_warnings(summary("rod", 0.05)) == []
     assert width_warnings(summary("plate", 0.5)) == []                       # not a 1D model
-    outside = width_warnings(summary("rod", 0.05, lb=4000.0))
-    assert len(outside) == 1 and "outside the error map" in outside[0] and "L/b = 4000" in outside[0]
+    outside = width_warnings(summary("rod", 0.05, lb=8000.0))
+    assert len(outside) == 1 and "outside the error map" in outside[0] and "L/b = 8000" in outside[0]
+    # between L/b = 1181 and 4000: predicted from both, with the margin (0.034 measured on the committed map)
+    (between,) = width_warnings(summary("rod", 0.05, lb=2000.0))
+    assert "dL0.5_W0.05_Lb1181, dL0.5_W0.05_Lb4000" in between and "margin" in between
     assert width_warnings(summary("rod", 0.3), error_map=tmp_path / "none.csv") == []   # no such map: no check
     ribbon = width_warnings(summary("ribbon", 0.05))
     assert len(ribbon) == 1 and "has no dW1 bound of this model" in ribbon[0] and "not located" in ribbon[0]

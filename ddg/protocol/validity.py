@@ -25,7 +25,7 @@ import warnings
 
 from ..analysis.observables import RESOLVED_STRAIN, RESOLVED_TURN_ANGLE_DEG
 
-#: dW1/L error + reference error bar (units of L) above which a 1D model misses the width effect.
+#: dW1/L error + reference error bar (units of L) above which the map does not show a 1D model good enough.
 WIDTH_TOLERANCE = 0.01
 #: The models without a resolved width (ddg.api.ROD_FAMILY).
 ONE_D_MODELS = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-wunderlich")
@@ -164,5 +164,6 @@ def width_warnings(summary: dict, error_map=None) -> list[str]:
         return []
     basis_text = names if margin is None else f"{names}, times the {margin.text()}"
     return [f"{where}: the error map predicts its dW1/L off the shell's by {best:.3f} (error + reference error "
-            f"bar, its best resolution {label}; from {basis_text}) > {WIDTH_TOLERANCE:g}: a 1D model misses the width "
-            "effect here; use --model plate or --model auto --tolerance"]
+            f"bar, its best resolution {label}; from {basis_text}) > {WIDTH_TOLERANCE:g}: the map does not show this "
+            "1D model, which carries no resolved width, within the tolerance here; use --model plate or --model auto "
+            "--tolerance"]

@@ -309,8 +309,8 @@ def stability_map(rows: list[dict]):
                    s=25 + 35 * (entry["reached_percent_of_dW_max"] or 0) / 100, zorder=3)
     for c, col in zip(STABILITY_CATEGORIES, STABILITY_COLORS):
         ax.scatter([], [], c=col, label=c)
-    ax.set_yticks([0, 1, 2])
-    ax.set_yticklabels(["rod", "plate", "ribbon"])
+    ax.set_yticks([0, 1, 2, 3])
+    ax.set_yticklabels(["rod", "plate", "ribbon", "ribbons with width"])
     ax.set_xlabel("W/L (upper row of each model: dL/L = 1/4)")
     ax.legend(fontsize=6, loc="upper right")
     return fig

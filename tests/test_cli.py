@@ -188,13 +188,15 @@ def test_plate_mesh_of_the_wrong_width_is_a_one_line_error(tmp_path, capsys):
     assert len(err.splitlines()) == 1 and "width" in err
 
 
-def test_rod_frames_are_polylines(tmp_path):
+def test_rod_frames_are_the_ribbon_the_rod_stands_for(tmp_path):
+    """Two triangles per edge over two points per node (ddg.output.frame_fields), so rods render
+    like plates in ParaView; the centreline is the mid-line of the ribbon."""
     meshio = pytest.importorskip("meshio")
     assert main(SMALL_RUN + ["--frames", "--out", str(tmp_path)]) == 0
     frames = sorted((tmp_path / "frames").glob("frame_*.vtu"))
     assert len(frames) == 1 + 5 + 4
     last = meshio.read(frames[-1])
-    assert last.cells[0].type == "line" and len(last.points) == 20
+    assert last.cells[0].type == "triangle" and len(last.points) == 2 * 20 and len(last.cells[0].data) == 2 * 19
     with open(tmp_path / "centerline.csv") as fh:
         rows = [r for r in csv.DictReader(fh) if r["row"] == "9"]
     assert float(rows[-1]["y_over_L"]) == pytest.approx(0.1, abs=1e-12)  # the sheared clamp point

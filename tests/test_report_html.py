@@ -124,8 +124,15 @@ def test_the_paper_figures_draw_from_their_data(tmp_path):
         (tmp_path / f"curvatures_{model}" / "curvatures.csv").write_text(
             "model,step,dL_over_L,dW_over_L,s_over_L,k1_L,k2_L,tau_L\n"
             + "".join(f"{model},0,0.5,0.2,{s},0.0,{s * 3},{-s}\n" for s in (0.1, 0.5, 0.9)))
+    for name in ("rod", "ribbon_rod"):
+        run = tmp_path / "a11" / "W0.05" / name
+        run.mkdir(parents=True)
+        (run / "path.csv").write_text("stage,dL_over_L,dW_over_L,H_mid_over_L,phase\ncompression,0.5,0,0.37,U\n"
+                                      "shear,0.5,0.1,0.36,U\nshear,0.5,0.4,0.2,US+\n")
     found = {f.name: f for f in paper_figures(tmp_path)}
-    assert set(found) == {"centerline_error", "curvature_profiles"}
+    assert set(found) == {"centerline_error", "curvature_profiles", "sadowsky_a11"}
+    assert len(found["sadowsky_a11"].rows) == 4          # the shear rows only
+    figures.draw(found["sadowsky_a11"])
     fig = figures.draw(found["centerline_error"])
     assert fig.axes[0].get_xscale() == "log"
     png = figures.save(figures.draw(found["curvature_profiles"]), tmp_path / "out", "curvature_profiles")

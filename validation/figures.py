@@ -287,8 +287,8 @@ def speed_accuracy(rows: list[dict], reference: str):
         ax.set_xlabel("wall time of the full path (s)")
         ax.set_ylabel(label)
         ax.legend(fontsize=7)
-    fig.suptitle(f"W/L = 1/6, dL/L = 1/2; reference: {reference}\nwall times as measured by the report's runs "
-                 "(labels: resolution; see the caption for the load on the machine)", fontsize=8)
+    fig.suptitle(f"W/L = 1/6, dL/L = 1/2; reference: {reference}\nwall times as the report's runs measured them "
+                 "(labels: resolution)", fontsize=8)
     fig.tight_layout()
     return fig
 
@@ -423,7 +423,31 @@ def curvature_profiles(rows: list[dict]):
     return fig
 
 
-DRAW = {"elastica": elastica, "centerline_error": centerline_error, "curvature_profiles": curvature_profiles, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
+A11_STYLES = {"rod": ("tab:blue", "-"), "plate": ("tab:orange", "-"), "ribbon_direct": ("tab:green", "--"),
+              "ribbon_rod": ("tab:red", ":")}
+
+
+def sadowsky_a11(rows: list[dict]):
+    """Fig. A.11: H_mid/L against dW/L per model, one panel per W/L."""
+    plt = _pyplot()
+    widths = sorted({r["width_ratio"] for r in rows})
+    fig, axes = _panel_grid(plt, len(widths), len(widths), (4.4, 3.4))
+    for ax, width in zip(axes, widths):
+        for (model,), sel in _groups([r for r in rows if r["width_ratio"] == width], "model"):
+            colour, style = A11_STYLES.get(model, ("gray", "-"))
+            sel = sorted(sel, key=lambda r: r["dW_over_L"])
+            ax.plot([r["dW_over_L"] for r in sel], [r["H_mid_over_L"] for r in sel], style, color=colour, lw=1.3,
+                    label=model.replace("_", " "))
+        ax.set_title(f"W/L = {fraction(width)}, dL/L = 1/2", fontsize=9)
+        ax.set_xlabel("dW/L")
+        ax.set_ylabel("H_mid/L")
+        _legend(ax, 7)
+    fig.tight_layout()
+    return fig
+
+
+DRAW = {"elastica": elastica, "centerline_error": centerline_error, "curvature_profiles": curvature_profiles,
+        "sadowsky_a11": sadowsky_a11, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
         "convergence": convergence, "poisson": poisson, "speed_accuracy": speed_accuracy,
         "stability_map": stability_map, "snapshots": snapshots, "wide_ribbons": wide_ribbons}
 

@@ -628,6 +628,21 @@ def paper_figures(folder: Path | None = None) -> list[FigureData]:
         path = folder / f"curvatures_{model}" / "curvatures.csv"
         if path.exists():
             profiles += _numeric_csv(path)
+    a11 = []
+    for folder_w in sorted((folder / "a11").glob("W*")) if (folder / "a11").is_dir() else []:
+        width = float(folder_w.name[1:])
+        if abs(1 / width - round(1 / width)) < 0.01:   # W0.1667 is 1/6 written to 4 digits
+            width = 1 / round(1 / width)
+        for run in sorted(p for p in folder_w.iterdir() if (p / "path.csv").exists()):
+            a11 += [{"model": run.name, "width_ratio": width, "dW_over_L": r["dW_over_L"],
+                     "H_mid_over_L": r["H_mid_over_L"]}
+                    for r in _numeric_csv(run / "path.csv") if r["stage"] == "shear"]
+    if a11:
+        out.append(_records_figure(
+            "sadowsky_a11", "sadowsky_a11",
+            "H_mid/L against dW/L at dL/L = 1/2 (paper Fig. A.11): the rod (M = 100), the plate (2000 triangles), "
+            "the Sadowsky ribbon from the flat strip (ribbon_direct) and relaxed from each rod equilibrium "
+            "(ribbon_rod, the paper's DAR-Sadowsky), one panel per W/L (data/paper_figures/a11).", a11))
     if profiles:
         out.append(_records_figure(
             "curvature_profiles", "curvature_profiles",
@@ -808,7 +823,9 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
     figures.append(_records_figure(
         "speed_accuracy", "speed_accuracy",
         "Speed against accuracy: each model and resolution, wall time of the full path (thresholds included) "
-        f"against its error relative to the {ref_name}; dashed: the Pareto front.", speed, {"reference": ref_name}))
+        f"against its error relative to the {ref_name}; dashed: the Pareto front. The wall times are as the report's "
+        "runs measured them: with --jobs N, N runs share the cores (README: how the committed snapshot was made).",
+        speed, {"reference": ref_name}))
     smap = stability_map(results, golds, thresholds)
     figures.append(_records_figure("stability_map", "stability_map",
                                    "Where each model fails and how (marker size: share of dW_max reached).", smap))

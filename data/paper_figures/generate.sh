@@ -17,3 +17,18 @@ for model in rod ribbon plate; do
     $PY -m ddg curvatures --model $model --width-ratio 0.05 --compression-ratio 0.5 --shear-ratios 0.2,0.45,0.6 \
         --out $OUT/curvatures_$model
 done
+# Fig. A.11: H_mid/L against dW/L at dL/L = 1/2 from the rod, the plate, the Sadowsky ribbon from the
+# flat strip ("direct") and the Sadowsky ribbon relaxed from each rod equilibrium ("rod", DAR-Sadowsky)
+for width in 0.05 0.1667; do
+  for spec in "rod rod --resolution 100" "plate plate --resolution 2000" "ribbon_direct ribbon --ribbon-init direct" \
+              "ribbon_rod ribbon --ribbon-init rod"; do
+    set -- $spec
+    name=$1; model=$2; shift 2
+    folder=$OUT/a11/W$width/$name
+    if [ ! -f $folder/summary.json ] || ! grep -q '"status": "complete"' $folder/summary.json; then
+      $PY -m ddg simulate --model $model "$@" --width-ratio $width --compression-ratio 0.5 --no-branches --quiet \
+          --out $folder || true   # a stopped run is kept as it is (its summary says why)
+      find $folder -type f ! -name path.csv ! -name summary.json -delete   # the figure needs the path only
+    fi
+  done
+done

@@ -16,7 +16,7 @@ from .report_data import FigureData, fraction
 
 COLORS = {"rod": "tab:blue", "plate": "tab:orange", "ribbon": "tab:green", "fem": "black",
           "ribbon-sano-wada": "tab:olive", "ribbon-trapeze": "tab:purple", "ribbon-wunderlich": "tab:brown",
-          "fem (extrapolated)": "black"}
+          "fem (extrapolated)": "black", "fem (converged)": "black", "plate (converged)": "tab:orange"}
 STABILITY_CATEGORIES = ["ok", "ok (mesh unresolved near dW_max)", "missed pitchfork", "dW1 unresolved by the mesh",
                         "rod width error", "Newton failure"]
 STABILITY_COLORS = ["tab:green", "yellowgreen", "tab:red", "tab:orange", "tab:purple", "black"]
@@ -130,13 +130,21 @@ def shear_curves(rows: list[dict], panels: list[tuple[float, float]], thresholds
     return fig
 
 
-def _legend(ax, size: float = 6.5) -> None:
-    """One entry per label (the threshold lines repeat them), outside the data where it fits."""
+def _legend(ax, size: float = 6.5, outside: bool = False, others=()) -> None:
+    """One entry per label (the threshold lines repeat them; `others`: more axes whose entries it
+    shows too): where it hides least, or beside the axes."""
     handles, labels = ax.get_legend_handles_labels()
+    for other in others:
+        more = other.get_legend_handles_labels()
+        handles, labels = list(more[0]) + list(handles), list(more[1]) + list(labels)
     seen = {}
     for h, label in zip(handles, labels):
         seen.setdefault(label, h)
-    if seen:
+    if not seen:
+        return
+    if outside:
+        ax.legend(list(seen.values()), list(seen), fontsize=size, loc="center left", bbox_to_anchor=(1.01, 0.5))
+    else:
         ax.legend(list(seen.values()), list(seen), fontsize=size, framealpha=0.85, loc="best")
 
 
@@ -160,10 +168,18 @@ def thresholds(rows: list[dict], compressions: list[float], dW_max: dict, paper:
     for ax, compression in zip(axes.flat, compressions):
         ax.plot(*zip(*dW_max[compression]), "k-", lw=0.8, label="dW_max (Eq. B.1)")
         for (model,), sel in _groups([r for r in rows if r["compression_ratio"] == compression], "model"):
+            converged = model.endswith("(converged)")
             for key, marker in (("dW1_over_L", "o-"), ("dW2_over_L", "s--")):
-                pts = [(r["width_ratio"], r[key]) for r in sel if r[key] is not None]
-                if pts:
-                    ax.plot(*zip(*pts), marker, color=COLORS[model], ms=4, label=f"{model} {key[:3]}")
+                pts = [(r["width_ratio"], r[key], r.get(f"{key[:3]}_error_bar")) for r in sel if r[key] is not None]
+                if not pts:
+                    continue
+                if converged:   # the benchmark's converged values: open markers with their error bars
+                    ax.errorbar([p[0] for p in pts], [p[1] for p in pts], yerr=[p[2] or 0.0 for p in pts],
+                                fmt=marker[0], mfc="none", ms=6, capsize=2.5, lw=0.9, color=COLORS.get(model, "gray"),
+                                label=f"{model} {key[:3]}")
+                else:
+                    ax.plot(*zip(*[p[:2] for p in pts]), marker, color=COLORS.get(model, "gray"), ms=4,
+                            label=f"{model} {key[:3]}")
         _shade_phases(ax, [r for r in rows if r["compression_ratio"] == compression], dW_max[compression])
         for k, p in enumerate(p for p in paper if p["compression_ratio"] == compression):
             ax.plot([p["width_ratio"]], [p["value"]], "v" if p["key"] == "dW1" else "^", color="crimson", ms=7,
@@ -171,7 +187,7 @@ def thresholds(rows: list[dict], compressions: list[float], dW_max: dict, paper:
         ax.set_title(f"dL/L = {fraction(compression)}", fontsize=9)
         ax.set_xlabel("W/L")
         ax.set_ylabel("threshold dW/L")
-        _legend(ax, 6)
+    _legend(list(axes.flat)[-1], 6.5, outside=True, others=list(axes.flat)[:-1])
     fig.tight_layout()
     return fig
 
@@ -182,7 +198,7 @@ PHASE_SHADES = (("U", "#e8f0ff"), ("US", "#fff3d6"), ("S", "#e6f6e6"))
 def _shade_phases(ax, rows: list[dict], dw_max: list[tuple[float, float]]) -> None:
     """U below dW1, US between dW1 and dW2, S between dW2 and dW_max, from the reference's
     thresholds (the FEM's where the rows have it, else the plate's), shaded and labelled."""
-    for model in ("fem", "fem (extrapolated)", "plate"):
+    for model in ("fem (converged)", "fem", "fem (extrapolated)", "plate"):
         sel = sorted((r for r in rows if r["model"] == model and r["dW1_over_L"] is not None),
                      key=lambda r: r["width_ratio"])
         if len(sel) >= 2:

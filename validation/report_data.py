@@ -298,16 +298,24 @@ def threshold_table(results, profile, golds) -> list[dict]:
     return table
 
 
-def thresholds_figure(table) -> FigureData:
-    """The threshold table against W/L per compression (paper Fig. 8 phase boundaries)."""
+def thresholds_figure(table, benchmark: list[dict] | None = None) -> FigureData:
+    """The threshold table against W/L per compression (paper Fig. 8 phase boundaries), with the
+    converged FEM and plate thresholds and their error bars from the benchmark (data/benchmark)."""
     rows, dw_max, paper = [], {}, []
     for compression in COMPRESSIONS:
         dw_max[compression] = [(x, shear_limit(1.0, x, compression)) for x in np.linspace(1 / 20, 1 / 2, 100)]
         for model in MODELS + ("fem",):
             sel = sorted((r for r in table if r["model"] == model and r["compression_ratio"] == compression),
                          key=lambda r: r["width_ratio"])
-            rows += [[model, compression, r["width_ratio"], r["dW1_over_L"], r["dW2_over_L"], r["dW_max_over_L"]]
-                     for r in sel]
+            rows += [[model, compression, r["width_ratio"], r["dW1_over_L"], r["dW2_over_L"], r["dW_max_over_L"],
+                      None, None] for r in sel]
+        for prefix in ("fem", "plate"):
+            for b in sorted((b for b in benchmark or () if abs(float(b["compression_ratio"]) - compression) < 1e-9),
+                            key=lambda b: float(b["width_ratio"])):
+                w = float(b["width_ratio"])
+                rows.append([f"{prefix} (converged)", compression, w, b.get(f"{prefix}_dW1"), b.get(f"{prefix}_dW2"),
+                             shear_limit(1.0, w, compression), b.get(f"{prefix}_dW1_error_bar"),
+                             b.get(f"{prefix}_dW2_error_bar")])
         for width in sorted({r["width_ratio"] for r in table}):
             paper += [{"compression_ratio": compression, "width_ratio": width, "key": key,
                        "value": paper_value(compression, width, key)}
@@ -315,8 +323,10 @@ def thresholds_figure(table) -> FigureData:
     return FigureData(
         "thresholds_vs_width", "thresholds",
         "Thresholds dW1/L (U to US) and dW2/L (US to S) against W/L (paper Fig. 8 phase boundaries), with the "
-        "shear limit dW_max.",
-        ["model", "compression_ratio", "width_ratio", "dW1_over_L", "dW2_over_L", "dW_max_over_L"], rows,
+        "shear limit dW_max; the converged FEM and plate thresholds with their error bars (the benchmark, "
+        "data/benchmark); shaded: U, US and S by the converged FEM thresholds.",
+        ["model", "compression_ratio", "width_ratio", "dW1_over_L", "dW2_over_L", "dW_max_over_L",
+         "dW1_error_bar", "dW2_error_bar"], rows,
         {"compressions": list(COMPRESSIONS), "dW_max": dw_max, "paper": paper})
 
 
@@ -808,7 +818,9 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
 
     figures = [elastica_figure(results, profile, golds), *shear_curve_figures(results, profile, golds)]
     thresholds = threshold_table(results, profile, golds)
-    figures.append(thresholds_figure(thresholds))
+    bench = benchmark_table()
+    figures.append(thresholds_figure(thresholds, [{k: finite_float(v) if k.endswith(("dW1", "dW2", "_bar", "ratio"))
+                                                   else v for k, v in r.items()} for r in bench.rows]))
     force = shear_force_figure(results, profile, golds)
     if force is not None:
         figures.append(force)
@@ -842,7 +854,7 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
         "convergence": Table("convergence", list(conv[0].keys()) if conv else [], conv),
         "stability_map": Table("stability_map", smap_columns, smap, csv=True,
                                shown=[c for c in smap_columns if c != "message"]),
-        "benchmark": benchmark_table(),
+        "benchmark": bench,
     }
     map_rows = error_map_rows()
     if map_rows:

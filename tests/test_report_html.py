@@ -129,8 +129,13 @@ def test_the_paper_figures_draw_from_their_data(tmp_path):
         run.mkdir(parents=True)
         (run / "path.csv").write_text("stage,dL_over_L,dW_over_L,H_mid_over_L,phase\ncompression,0.5,0,0.37,U\n"
                                       "shear,0.5,0.1,0.36,U\nshear,0.5,0.4,0.2,US+\n")
+    (tmp_path / "fig9").mkdir()
+    (tmp_path / "fig9" / "W0.05.csv").write_text(
+        "W_over_L,dW_over_L,s_over_L,w_over_L,delta_percent\n"
+        + "".join(f"0.05,0.3,{s},{w},{0.01 + s * abs(w)}\n" for s in (0.0, 0.5, 1.0) for w in (-0.025, 0.0, 0.025)))
     found = {f.name: f for f in paper_figures(tmp_path)}
-    assert set(found) == {"centerline_error", "curvature_profiles", "sadowsky_a11"}
+    assert set(found) == {"centerline_error", "curvature_profiles", "sadowsky_a11", "centerline_error_field"}
+    figures.draw(found["centerline_error_field"])
     assert len(found["sadowsky_a11"].rows) == 4          # the shear rows only
     figures.draw(found["sadowsky_a11"])
     fig = figures.draw(found["centerline_error"])
@@ -138,3 +143,17 @@ def test_the_paper_figures_draw_from_their_data(tmp_path):
     png = figures.save(figures.draw(found["curvature_profiles"]), tmp_path / "out", "curvature_profiles")
     assert png[:8] == PNG and (tmp_path / "out" / "curvature_profiles.pdf").exists()
     assert paper_figures(tmp_path / "none") == []
+
+
+def test_the_fig9_generator_refuses_a_bad_out_and_skips_finished_widths(tmp_path, capsys, monkeypatch):
+    from validation import paper_figures as pf
+
+    (tmp_path / "file").write_text("x")
+    assert pf.main(["--out", str(tmp_path / "file"), "--quiet"]) == 2
+    assert capsys.readouterr().err.startswith("error: ") and not (tmp_path / "file" / "fig9").exists()
+    for width in pf.FIG9_WIDTHS:                     # every width finished: nothing is run
+        pf.field_file(tmp_path / "out", width).parent.mkdir(parents=True, exist_ok=True)
+        pf.field_file(tmp_path / "out", width).write_text("W_over_L\n")
+    import ddg.analysis.curvatures as curvatures
+    monkeypatch.setattr(curvatures, "states_at_shears", lambda *a, **k: 1 / 0)
+    assert pf.write_fields(tmp_path / "out", quiet=True) == []

@@ -439,6 +439,47 @@ def curvature_profiles(rows: list[dict]):
     return fig
 
 
+def centerline_error_field(rows: list[dict]):
+    """Fig. 9b: delta(s, w) in % of L on the flat strip, a row of panels per W/L, a column per
+    dW/L, one colour scale (log) for all."""
+    import matplotlib.colors as mcolors
+    import matplotlib.tri as mtri
+
+    plt = _pyplot()
+    widths = sorted({r["W_over_L"] for r in rows})
+    shears = sorted({r["dW_over_L"] for r in rows})
+    values = np.array([r["delta_percent"] for r in rows], dtype=float)
+    positive = values[values > 0]
+    norm = mcolors.LogNorm(vmin=max(positive.min(), positive.max() * 1e-4), vmax=positive.max())
+    fig, axes = plt.subplots(len(widths), len(shears), figsize=(4.6 * len(shears), 1.0 + 1.6 * len(widths)),
+                             squeeze=False)
+    fig.subplots_adjust(hspace=0.75, wspace=0.25, right=0.82)
+    image = None
+    for i, width in enumerate(widths):
+        for j, shear in enumerate(shears):
+            sel = [r for r in rows if r["W_over_L"] == width and r["dW_over_L"] == shear]
+            ax = axes[i][j]
+            if not sel:
+                ax.set_visible(False)
+                continue
+            s = np.array([r["s_over_L"] for r in sel])
+            w = np.array([r["w_over_L"] for r in sel])
+            raw = np.array([r["delta_percent"] for r in sel], dtype=float)
+            image = ax.tripcolor(mtri.Triangulation(s, w), np.maximum(raw, norm.vmin), shading="gouraud", norm=norm,
+                                 cmap="viridis")
+            ax.set_title(f"W/L = {fraction(width)}, dW/L = {shear:g}: mean {np.mean(raw):.2g} %, max "
+                         f"{np.max(raw):.2g} %", fontsize=8)
+            ax.set_xlim(0, 1)
+            ax.set_ylabel("w/L", fontsize=7)
+            ax.tick_params(labelsize=6)
+        axes[i][0].set_ylabel("w/L", fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("s/L", fontsize=8)
+    if image is not None:
+        fig.colorbar(image, cax=fig.add_axes([0.85, 0.15, 0.02, 0.7]), label="delta (% of L), log scale")
+    return fig
+
+
 A11_STYLES = {"rod": ("tab:blue", "-"), "plate": ("tab:orange", "-"), "ribbon_direct": ("tab:green", "--"),
               "ribbon_rod": ("tab:red", ":")}
 
@@ -463,7 +504,7 @@ def sadowsky_a11(rows: list[dict]):
 
 
 DRAW = {"elastica": elastica, "centerline_error": centerline_error, "curvature_profiles": curvature_profiles,
-        "sadowsky_a11": sadowsky_a11, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
+        "sadowsky_a11": sadowsky_a11, "centerline_error_field": centerline_error_field, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
         "convergence": convergence, "poisson": poisson, "speed_accuracy": speed_accuracy,
         "stability_map": stability_map, "snapshots": snapshots, "wide_ribbons": wide_ribbons}
 

@@ -633,6 +633,16 @@ def paper_figures(folder: Path | None = None) -> list[FigureData]:
             "The plate's centreline against the best centreline of a rod (paper Fig. 10, Eq. 13): mean and largest "
             "deviation delta in % of L against L/W on a log axis (L/W = 20 at the right), one line per dW/L; "
             "plate on 2000 triangles, dL/L = 1/2 (`python -m ddg centerline-error`, data/paper_figures).", rows))
+    fields = []
+    for path in sorted((folder / "fig9").glob("W*.csv")) if (folder / "fig9").is_dir() else []:
+        fields += _numeric_csv(path)
+    if fields:
+        out.append(_records_figure(
+            "centerline_error_field", "centerline_error_field",
+            "The centreline approximation over the plate (paper Fig. 9b): delta(s, w) of Eq. (13), the distance from "
+            "each deformed plate node to where the centreline and its material frame put it (Eq. 12), in % of L, "
+            "on the flat strip (s, w); rows W/L, columns dW/L; plate on 2000 triangles, dL/L = 1/2 "
+            "(`python -m validation.paper_figures`, data/paper_figures/fig9).", fields))
     profiles = []
     for model in ("rod", "ribbon", "plate"):
         path = folder / f"curvatures_{model}" / "curvatures.csv"

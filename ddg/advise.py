@@ -228,7 +228,8 @@ def basis_scenes(rows, scene: Scene) -> tuple[list[Scene], str]:
 
 
 # ------------------------------------------------------------------------------------ prediction
-def _at_scene(row, s: Scene) -> bool:
+def at_scene(row, s: Scene) -> bool:
+    """The map row is of scene s (dL/L, W/L and L/b the same to SAME)."""
     return (_same(float(row["compression_ratio"]), s.compression_ratio)
             and _same(float(row["width_ratio"]), s.width_ratio) and _same(float(row["slenderness"]), s.slenderness))
 
@@ -267,7 +268,7 @@ def predictions(rows, basis: list[Scene], runnable=None, margin: float = 1.0) ->
     out = []
     for (model, resolution, label), mine in candidates.items():
         errors, why, times = {}, {}, []
-        per_scene = [[r for r in mine if _at_scene(r, s)] for s in basis]
+        per_scene = [[r for r in mine if at_scene(r, s)] for s in basis]
         for q in QUANTITIES:
             values = []
             for s, found in zip(basis, per_scene):
@@ -314,6 +315,25 @@ RULE_V1_MARGIN = Margin(1.0, 0, 0, "rule v1: no margin")
 ON_A_MAP_SCENE = Margin(1.0, 0, 0, "on a map scene: measured there")
 
 
+def compared_at(rows, scene: Scene, basis: list[Scene], runnable=None, margin: float = 1.0,
+                quantities=QUANTITIES) -> list[tuple[Prediction, str, float, float]]:
+    """Leave one out: `scene`'s own rows are set aside, the other `rows` predict each candidate on
+    `basis` (times `margin`), and each prediction meets the candidate's measured bound at `scene`:
+    (prediction, quantity, predicted, measured) wherever both exist."""
+    mine = {(r["model"], r["resolution_label"]): r for r in rows if at_scene(r, scene)}
+    others = [r for r in rows if not at_scene(r, scene)]
+    out = []
+    for p in predictions(others, basis, runnable, margin):
+        row = mine.get((p.model, p.label))
+        if row is None:
+            continue
+        for q in quantities:
+            predicted, measured = p.errors.get(q), row.get(f"{q}_bound")
+            if predicted is not None and measured is not None:
+                out.append((p, q, predicted, measured))
+    return out
+
+
 def cross_validated_margin(rows, runnable=None) -> Margin:
     """Leave-one-out on the fitting rows (held-out rows are dropped first): each scene bracketed
     by the others is predicted from them with margin 1; the margin is the largest ratio measured
@@ -321,27 +341,17 @@ def cross_validated_margin(rows, runnable=None) -> Margin:
     rows = fitting(rows)
     worst, where, compared, scenes = 1.0, "none above 1", 0, 0
     for scene in map_scenes(rows):
-        reduced = [r for r in rows if not _at_scene(r, scene)]
-        basis, _ = basis_scenes(reduced, scene)
+        basis, _ = basis_scenes([r for r in rows if not at_scene(r, scene)], scene)
         if not basis:
             continue
         scenes += 1
-        mine = {}
-        for r in rows:
-            if _at_scene(r, scene):
-                mine[(r["model"], r["resolution_label"])] = r
-        for p in predictions(reduced, basis, runnable):
-            row = mine.get((p.model, p.label))
-            if row is None:
+        for p, q, predicted, measured in compared_at(rows, scene, basis, runnable):
+            if not predicted > 0:
                 continue
-            for q in QUANTITIES:
-                predicted, measured = p.errors.get(q), row.get(f"{q}_bound")
-                if predicted is None or measured is None or not predicted > 0:
-                    continue
-                compared += 1
-                if measured / predicted > worst:
-                    worst = measured / predicted
-                    where = f"{p.model} {p.label} {q} at {scene.name}: {measured:.4f} against {predicted:.4f}"
+            compared += 1
+            if measured / predicted > worst:
+                worst = measured / predicted
+                where = f"{p.model} {p.label} {q} at {scene.name}: {measured:.4f} against {predicted:.4f}"
     return Margin(worst, compared, scenes, where)
 
 

@@ -47,9 +47,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ddg.advise import (QUANTITIES, RULE_V1_MARGIN, basis_scenes, choose, cross_validated_margin, fitting, map_scenes,
-                        parse_rows, predictions, scene_name)
-from ddg.advise import Scene as MapScene
+from ddg.advise import (QUANTITIES, RULE_V1_MARGIN, at_scene, basis_scenes, choose, compared_at, cross_validated_margin,
+                        fitting, map_scenes, parse_rows, scene_name)
 from ddg.output.io import StoredRun, atomic_write_text, finished_run_summary, finite_float, write_table_csv
 
 from .claims import THRESHOLD_BAND
@@ -460,9 +459,9 @@ def held_out_check(rows: list[dict], tolerance: float = 0.01, quantities=QUANTIT
     fit = fitting(parsed)
     out = []
     for scene in map_scenes(parsed):
-        same = [r for r in parsed if _is(r, scene)]
+        same = [r for r in parsed if at_scene(r, scene)]
         role = "held-out" if same and same[0].get("role") == "held-out" else "fit"
-        reduced = [r for r in fit if not _is(r, scene)]
+        reduced = [r for r in fit if not at_scene(r, scene)]
         basis, why = basis_scenes(reduced, scene)
         entry = {"scene": scene.name, "role": role, "held_out": bool(basis), "why": why,
                  "basis": [s.name for s in basis],
@@ -474,20 +473,14 @@ def held_out_check(rows: list[dict], tolerance: float = 0.01, quantities=QUANTIT
         runnable = {r["model"] for r in parsed if r["model"] != "fem"}
         margin = RULE_V1_MARGIN if rule == "v1" else cross_validated_margin(reduced, runnable)
         entry["margin"] = margin.value
-        for p in predictions(reduced, basis, runnable, margin.value):
-            mine = [r for r in same if r["model"] == p.model and r["resolution_label"] == p.label]
-            if not mine:
-                continue
-            for q in quantities:
-                predicted, measured = p.errors.get(q), mine[-1].get(f"{q}_bound")
-                if predicted is None or measured is None:
-                    continue
-                entry["compared"] += 1
-                if measured <= predicted + 1e-12:
-                    entry["held"] += 1
-                else:
-                    entry["violations"].append(f"{p.model} {p.label} {q}: measured {measured:.4f} > predicted "
-                                               f"{predicted:.4f}")
+        for p, q, predicted, measured in compared_at(reduced + same, scene, basis, runnable, margin.value,
+                                                     quantities):
+            entry["compared"] += 1
+            if measured <= predicted + 1e-12:
+                entry["held"] += 1
+            else:
+                entry["violations"].append(f"{p.model} {p.label} {q}: measured {measured:.4f} > predicted "
+                                           f"{predicted:.4f}")
         choice = choose(scene.width_ratio, scene.compression_ratio, scene.slenderness, tolerance, quantities,
                         rows=reduced, runnable=runnable, margin=margin)
         entry["choice"] = f"{choice.model} {choice.label}" + (" (safe choice)" if choice.safe else "")
@@ -504,12 +497,6 @@ def held_out_check(rows: list[dict], tolerance: float = 0.01, quantities=QUANTIT
 def load_rows(rows: list[dict]) -> list[dict]:
     """Rows of the CSV (strings) parsed as ddg.advise.load_map parses the file."""
     return parse_rows(rows)
-
-
-def _is(row: dict, scene: MapScene) -> bool:
-    return (abs(float(row["compression_ratio"]) - scene.compression_ratio) < 1e-9
-            and abs(float(row["width_ratio"]) - scene.width_ratio) < 1e-6 * scene.width_ratio
-            and abs(float(row["slenderness"]) - scene.slenderness) < 1e-6 * scene.slenderness)
 
 
 # ------------------------------------------------------------------------------------ README, figures

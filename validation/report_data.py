@@ -603,23 +603,12 @@ def error_map_rows(path: Path | None = None) -> list[dict]:
     return read_table(path) if path.exists() else []
 
 
-def _numeric_csv(path: Path) -> list[dict]:
-    import csv
-
-    def number(v):
-        try:
-            return float(v)
-        except (TypeError, ValueError):
-            return v
-
-    with open(path, newline="") as fh:
-        return [{k: number(v) for k, v in row.items()} for row in csv.DictReader(fh)]
-
-
 def paper_figures(folder: Path | None = None) -> list[FigureData]:
     """The figures after the paper's Fig. 10 (the centreline approximation, Eq. 13) and Figs.
     A.12-14 (curvature profiles) from their committed data (data/paper_figures/generate.sh); the
     ones whose data are missing are left out."""
+    from ddg.output.io import read_numeric_rows
+
     from .reference import ROOT
 
     folder = Path(folder) if folder is not None else ROOT / "data" / "paper_figures"
@@ -627,7 +616,7 @@ def paper_figures(folder: Path | None = None) -> list[FigureData]:
     errors = folder / "centerline_error" / "centerline_error.csv"
     if errors.exists():
         rows = [{k: r[k] for k in ("L_over_W", "W_over_L", "dW_over_L", "mean_error", "max_error", "phase")}
-                for r in _numeric_csv(errors)]
+                for r in read_numeric_rows(errors)]
         out.append(_records_figure(
             "centerline_error", "centerline_error",
             "The plate's centreline against the best centreline of a rod (paper Fig. 10, Eq. 13): mean and largest "
@@ -635,7 +624,7 @@ def paper_figures(folder: Path | None = None) -> list[FigureData]:
             "plate on 2000 triangles, dL/L = 1/2 (`python -m ddg centerline-error`, data/paper_figures).", rows))
     fields = []
     for path in sorted((folder / "fig9").glob("W*.csv")) if (folder / "fig9").is_dir() else []:
-        fields += _numeric_csv(path)
+        fields += read_numeric_rows(path)
     if fields:
         out.append(_records_figure(
             "centerline_error_field", "centerline_error_field",
@@ -647,7 +636,7 @@ def paper_figures(folder: Path | None = None) -> list[FigureData]:
     for model in ("rod", "ribbon", "plate"):
         path = folder / f"curvatures_{model}" / "curvatures.csv"
         if path.exists():
-            profiles += _numeric_csv(path)
+            profiles += read_numeric_rows(path)
     a11 = []
     for folder_w in sorted((folder / "a11").glob("W*")) if (folder / "a11").is_dir() else []:
         width = float(folder_w.name[1:])
@@ -656,7 +645,7 @@ def paper_figures(folder: Path | None = None) -> list[FigureData]:
         for run in sorted(p for p in folder_w.iterdir() if (p / "path.csv").exists()):
             a11 += [{"model": run.name, "width_ratio": width, "dW_over_L": r["dW_over_L"],
                      "H_mid_over_L": r["H_mid_over_L"]}
-                    for r in _numeric_csv(run / "path.csv") if r["stage"] == "shear"]
+                    for r in read_numeric_rows(run / "path.csv") if r["stage"] == "shear"]
     if a11:
         out.append(_records_figure(
             "sadowsky_a11", "sadowsky_a11",

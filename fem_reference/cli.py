@@ -120,6 +120,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--resolution", type=int, default=None,
                    help="elements along L of the coarsest mesh of each scene's study, 4..400 (default 64)")
     p.add_argument("--levels", type=int, default=None, help="meshes per scene, each 1.5 times finer, 1..4 (default 3)")
+    p.add_argument("--studies-only", action="store_true",
+                   help="no run: rewrite each selected scene's study (richardson.json, convergence.*) and the index "
+                        "from its finished runs")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_gold)
     return parser

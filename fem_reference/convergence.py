@@ -110,20 +110,29 @@ def study_estimates(runs, resolutions, band: float = 0.02, default_tolerances: d
     if len(sheared) >= 2:
         resolutions, runs = [n for n, _ in sheared], [r for _, r in sheared]
         rows, _ = summarise(runs, resolutions)
-        grid = sorted({row["dW_over_L"] for row in rows})
-        curve = []
-        for x in grid:
-            values = [next(row["H_mid_over_L"] for row in rows if row["resolution"] == n and row["dW_over_L"] == x)
-                      for n in resolutions]
-            e = estimate(values, resolutions)
-            curve.append({"dW_over_L": x, **{k: e[k] for k in ("value", "error_bar", "order", "asymptotic")}})
-        away = [c for c in curve if _away(np.array([c["dW_over_L"]]), *(e["value"] if e else None for e in (dw1, dw2)),
-                                          margin=band)[0]]
-        out["H_mid_curve"] = curve
-        out["H_mid_curve_away"] = {"band_over_L": band, "points": len(away),
-                                   "asymptotic_points": sum(c["asymptotic"] for c in away),
-                                   "max_error_bar": max((c["error_bar"] for c in away), default=None)}
+        thresholds = [e["value"] if e else None for e in (dw1, dw2)]
+        out["H_mid_curve"], out["H_mid_curve_away"] = _curve_estimates(rows, resolutions, "H_mid_over_L",
+                                                                       thresholds, band)
+        if all("F_shear_norm" in row for row in rows):
+            force, away = _curve_estimates(rows, resolutions, "F_shear_norm", thresholds, band)
+            if force:
+                out["F_shear_curve"], out["F_shear_curve_away"] = force, away
     return out
+
+
+def _curve_estimates(rows, resolutions, column: str, thresholds, band: float) -> tuple[list[dict], dict]:
+    """estimate() of `column` (summarise's rows) at every dW of the common grid, and the figures of
+    its points more than `band` from the thresholds (points, asymptotic points, largest error bar)."""
+    values = {(row["resolution"], row["dW_over_L"]): row[column] for row in rows}
+    curve = []
+    for x in sorted({row["dW_over_L"] for row in rows}):
+        e = estimate([values[(n, x)] for n in resolutions], resolutions)
+        if e is None:   # no mesh recorded it there (nan)
+            continue
+        curve.append({"dW_over_L": x, **{k: e[k] for k in ("value", "error_bar", "order", "asymptotic")}})
+    away = [c for c in curve if _away(np.array([c["dW_over_L"]]), *thresholds, margin=band)[0]]
+    return curve, {"band_over_L": band, "points": len(away), "asymptotic_points": sum(c["asymptotic"] for c in away),
+                   "max_error_bar": max((c["error_bar"] for c in away), default=None)}
 
 
 #: Meshes of one convergence study: at least 2 (Richardson extrapolation needs two; one mesh
@@ -249,16 +258,20 @@ def summarise(runs, resolutions):
     """Per-mesh H_mid(dW) on the coarsest run's recorded dW grid (each run interpolated onto it,
     up to the smallest dW all runs reached), extrapolated values and estimated errors."""
     shear = [[r for r in run.rows if r["stage"] == "shear"] for run in runs]
-    curves = []
+    curves, forces = [], []
     for s in shear:
         dw_i = np.array([row["dW_over_L"] for row in s])
         order = np.argsort(dw_i)
         curves.append((dw_i[order], np.array([row["H_mid_over_L"] for row in s])[order]))
+        force = [row.get("F_shear_norm") for row in s]
+        forces.append(None if any(f is None or f == "" for f in force) else np.array(force, float)[order])
     reach = min(c[0][-1] for c in curves)
     grid = [row for row in shear[0] if row["dW_over_L"] <= reach + 1e-12]
     n_common = len(grid)
     dw = np.array([row["dW_over_L"] for row in grid])
     H = np.array([np.interp(dw, *c) for c in curves])
+    # the clamp's shear force on the same grid (paper Fig. E.18), where every run recorded it
+    F = None if any(f is None for f in forces) else np.array([np.interp(dw, c[0], f) for c, f in zip(curves, forces)])
     def phase_nearest(rows, x):
         return rows[int(np.argmin(np.abs(np.array([r["dW_over_L"] for r in rows]) - x)))]["phase"]
 
@@ -271,7 +284,8 @@ def summarise(runs, resolutions):
         for j in range(n_common):
             rows.append({"resolution": resolutions[i], "dW_over_L": dw[j], "H_mid_over_L": H[i, j],
                          "phase": phases[i][j], "H_extrapolated": H_ext[j], "order": p[j],
-                         "error_estimate": abs(H[i, j] - H_ext[j])})
+                         "error_estimate": abs(H[i, j] - H_ext[j]),
+                         **({} if F is None else {"F_shear_norm": F[i, j]})})
     dw1 = np.array([np.nan if run.summary["dW1_over_L"] is None else run.summary["dW1_over_L"] for run in runs])
     dw2 = np.array([np.nan if run.summary["dW2_over_L"] is None else run.summary["dW2_over_L"] for run in runs])
     dw1_ext, p1 = extrapolate(dw1[:, None], resolutions) if len(runs) >= 2 else (dw1[-1:], [np.nan])
@@ -317,7 +331,7 @@ def _away(dw, dw1, dw2, margin=0.02):
 def write_outputs(out: Path, rows, table, runs, resolutions, strip, protocol) -> None:
     out.mkdir(parents=True, exist_ok=True)
     write_table_csv(out / "convergence.csv", rows)
-    keys = sorted({k for t in table for k in t}, key=lambda k: list(table[0]).index(k) if k in table[0] else 99)
+    keys = list(dict.fromkeys(k for t in table for k in t))   # first appearance: the same order on every run
     write_table_csv(out / "thresholds.csv", table, keys)
 
     def f(v, fmt="{:.5f}"):

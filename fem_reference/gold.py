@@ -140,10 +140,17 @@ def run_gold(args) -> int:
 
     selected = check_gold_inputs(args)  # before any FEM import
 
+    out = Path(args.out)
+    if getattr(args, "studies_only", False):   # no FEM import: the studies read the stored runs
+        for name, _, _, _, meshes in selected:
+            if (out / name).is_dir():
+                write_scene_study(out / name, meshes)
+        write_index(out)
+        return 0
+
     from .api import simulate
     from .continuation import ContinuationOptions
 
-    out = Path(args.out)
     options = ContinuationOptions(dw1_tolerance=GOLD_TOLERANCES[0], dw2_tolerance=GOLD_TOLERANCES[1])
     status = 0
     try:

@@ -60,14 +60,19 @@ def test_fewer_meshes_say_so():
     assert estimate([None, None, None], MESHES) is None
 
 
-def _stored_run(folder, along, across, dw1, dw2, heights, width=1 / 6):
-    """A finished gold run folder: summary.json and path.csv with the keys the study reads."""
+def _stored_run(folder, along, across, dw1, dw2, heights, width=1 / 6, forces=None):
+    """A finished gold run folder: summary.json and path.csv with the keys the study reads (the
+    clamp force F_shear_norm at each shear step where `forces` is given)."""
     from ddg.output.io import write_path_csv, write_summary_json
 
     folder.mkdir(parents=True)
     rows = [{"stage": "compression", "dL_over_L": 0.5, "dW_over_L": 0.0, "H_mid_over_L": heights[0], "phase": "U"}]
     rows += [{"stage": "shear", "dL_over_L": 0.5, "dW_over_L": 0.1 * k, "H_mid_over_L": h, "phase": "U"}
              for k, h in enumerate(heights[1:], start=1)]
+    if forces is not None:
+        rows[0]["F_shear_norm"] = 0.0
+        for row, f in zip(rows[1:], forces):
+            row["F_shear_norm"] = f
     write_path_csv(folder / "path.csv", rows)
     write_summary_json(folder / "summary.json", {
         "model": "fem", "status": "complete", "converged": True, "message": "path complete",
@@ -100,6 +105,37 @@ def test_a_scene_study_from_stored_runs(tmp_path):
     assert finest_run(scene).name == "N90x18"
     (scene / "summary.json").write_text("{}")  # a single run of the layout before the studies
     assert finest_run(scene) == scene
+
+
+def test_the_clamp_force_gets_a_converged_curve_and_the_map_hash_ignores_it(tmp_path):
+    """A force converging at order 2 on the three meshes is extrapolated exactly at each dW, in
+    F_shear_curve beside H_mid_curve (issue 18: the force claim's error bar); the error map's
+    reference hash of the study is that of the same study written without the force keys, so
+    adding them leaves the map's rows current. `gold --studies-only` rewrites the study, no run."""
+    from types import SimpleNamespace
+
+    from fem_reference.gold import run_gold, write_scene_study
+    from validation.error_map import UNREAD_STUDY_KEYS, _study_hash
+
+    scene = tmp_path / "dL0.5_W0.1667"
+    for along, across in [(64, 8), (96, 12), (144, 18)]:
+        heights = [0.37 + 1.0 / along**2, 0.36 + 2.0 / along**2, 0.35 + 3.0 / along**2]
+        forces = [0.5 + 40.0 / along**2, 1.2 - 90.0 / along**2]
+        _stored_run(scene / f"N{along}x{across}", along, across, 0.27, 0.43, heights, forces=forces)
+    study = write_scene_study(scene)
+    force = study["F_shear_curve"]
+    assert [round(p["dW_over_L"], 12) for p in force] == [0.1, 0.2]
+    assert [p["value"] for p in force] == pytest.approx([0.5, 1.2], abs=1e-12)
+    assert all(p["asymptotic"] and p["order"] == pytest.approx(2.0) for p in force)
+    assert study["F_shear_curve_away"]["points"] == 2
+    plain = tmp_path / "plain.json"
+    plain.write_text(json.dumps({k: v for k, v in study.items() if k not in UNREAD_STUDY_KEYS}, indent=2) + "\n")
+    assert _study_hash(scene / "richardson.json") == _study_hash(plain)
+    (scene / "richardson.json").unlink()
+    args = SimpleNamespace(out=str(tmp_path), only=["dL0.5_W0.1667"], levels=None, resolution=None, quiet=True,
+                           studies_only=True)
+    assert run_gold(args) == 0
+    assert json.loads((scene / "richardson.json").read_text())["F_shear_curve"] == force
 
 
 def test_the_error_map_scenes_are_named_by_their_strip_and_run_only_when_asked():

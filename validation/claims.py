@@ -168,26 +168,33 @@ def threshold_agreement(a, b, key: str = "dW1") -> Agreement | None:
     return Agreement(diff, combined, max(diff - combined, 0.0), 1, _scene(a) + f" {key}")
 
 
-def curve_agreement(a, b, band: float = THRESHOLD_BAND, upto: float | None = None) -> Agreement | None:
-    """Studies a and b on their H_mid(dW) curves, pointwise on a's grid inside b's range, `band`
-    away from both studies' thresholds and at most `upto`; None without a common point."""
+def curve_agreement(a, b, band: float = THRESHOLD_BAND, upto: float | None = None,
+                    quantity: str = "H_mid") -> Agreement | None:
+    """Studies a and b on a curve against dW/L ("H_mid": their H_mid(dW) curves, in units of L;
+    "force": their clamp-force curves relative to the scale of b's, the largest |F| of b on the
+    compared points), pointwise on a's grid inside b's range, `band` away from both studies'
+    thresholds and at most `upto`; None without a common point."""
     from .estimates import away_from
 
-    if a.curve is None or b.curve is None:
+    ca, cb = (a.curve, b.curve) if quantity == "H_mid" else (a.force, b.force)
+    if ca is None or cb is None:
         return None
-    dw = a.curve.dw
-    keep = (dw >= b.curve.dw[0]) & (dw <= b.curve.dw[-1]) & away_from(dw, a.thresholds() + b.thresholds(), band)
+    dw = ca.dw
+    keep = (dw >= cb.dw[0]) & (dw <= cb.dw[-1]) & away_from(dw, a.thresholds() + b.thresholds(), band)
     if upto is not None:
         keep &= dw <= upto
     if not np.any(keep):
         return None
-    vb, eb = b.curve.at(dw[keep])
-    diff = np.abs(a.curve.value[keep] - vb)
-    combined = a.curve.error_bar[keep] + eb
+    vb, eb = cb.at(dw[keep])
+    scale = 1.0 if quantity == "H_mid" else float(np.max(np.abs(vb)))
+    if not scale > 0:
+        return None
+    diff = np.abs(ca.value[keep] - vb) / scale
+    combined = (ca.error_bar[keep] + eb) / scale
     excess = diff - combined
     k = int(np.argmax(excess))
-    return Agreement(float(diff.max()), float(combined.max()), float(max(excess[k], 0.0)), int(keep.sum()),
-                     f"{_scene(a)} dW/L = {dw[keep][k]:.4f}")
+    where = f"{_scene(a)} dW/L = {dw[keep][k]:.4f}" + ("" if quantity == "H_mid" else f", max |F| {scale:.4g}")
+    return Agreement(float(diff.max()), float(combined.max()), float(max(excess[k], 0.0)), int(keep.sum()), where)
 
 
 def u_branch_agreement(a, b, band: float = THRESHOLD_BAND) -> Agreement | None:
@@ -279,6 +286,12 @@ def cross_model_verdicts(rods=None, dep6=None, load=None) -> list[dict]:
         verdict("plate_vs_fem_narrow_curve", "curve",
                 lambda: Agreement.worst([curve_agreement(p, f) for p, f, _ in narrow]), **narrow_missing),
         verdict("plate_vs_fem_own_material_curve", "curve", lambda: curve_agreement(plate6, dep6),
+                **{"plate study dL0.5_W0.1667": plate6, "FEM run with the plate's material": dep6}),
+        verdict("plate_vs_fem_force", "force",
+                lambda: Agreement.worst([curve_agreement(p, f, quantity="force")
+                                         for p, f, _ in [(plate6, fem6, "")] + narrow]),
+                **{"plate study dL0.5_W0.1667": plate6, "FEM study dL0.5_W0.1667": fem6}, **narrow_missing),
+        verdict("plate_vs_fem_own_material_force", "force", lambda: curve_agreement(plate6, dep6, quantity="force"),
                 **{"plate study dL0.5_W0.1667": plate6, "FEM run with the plate's material": dep6}),
     ]
     return out

@@ -38,6 +38,7 @@ from __future__ import annotations
 import argparse
 import csv
 import hashlib
+import json
 import math
 import signal
 import sys
@@ -99,6 +100,19 @@ def _hash(*paths: Path) -> str:
     for p in paths:
         digest.update(Path(p).read_bytes())
     return digest.hexdigest()[:16]
+
+
+#: Keys of a FEM study (richardson.json) the map does not read: left out of its reference hash, so
+#: that adding them (the clamp force's curve, issue 18) leaves the map's rows current.
+UNREAD_STUDY_KEYS = ("F_shear_curve", "F_shear_curve_away")
+
+
+def _study_hash(path: Path) -> str:
+    """_hash of a FEM study as written without UNREAD_STUDY_KEYS (the same bytes as a study
+    written before those keys existed)."""
+    study = json.loads(Path(path).read_text())
+    text = json.dumps({k: v for k, v in study.items() if k not in UNREAD_STUDY_KEYS}, indent=2) + "\n"
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
 def _relative(path: Path) -> str:
@@ -170,7 +184,7 @@ def reference_scenes() -> list[ReferenceScene]:
             stored = _stored_plates("plate", PLATE_GOLD / name) + _stored_plates("plate-midedge", MIDEDGE_GOLD / name)
             stored += _stored_fem(FEM_GOLD / name)
             out.append(ReferenceScene(c, w, None, study, _relative(study_file),
-                                      _hash(study_file) if study_file.exists() else "", stored))
+                                      _study_hash(study_file) if study_file.exists() else "", stored))
     gold_map = {}
     for c, w, lb in MAP_SCENES:
         name = fem_scene_name(c, w, lb)
@@ -181,7 +195,7 @@ def reference_scenes() -> list[ReferenceScene]:
         stored = _stored_plates("plate", PLATE_GOLD / name) + _stored_plates("plate-midedge", MIDEDGE_GOLD / name)
         stored += _stored_fem(FEM_GOLD / name)
         gold_map[(c, w, lb)] = ReferenceScene(c, w, lb, study, _relative(study_file),
-                                              _hash(study_file), stored, name)
+                                              _study_hash(study_file), stored, name)
     out += list(gold_map.values())
     for lb in NARROW_SLENDERNESS:
         if (0.5, 1 / 20, lb) in gold_map:   # a three-mesh gold study of the same scene replaces the two meshes

@@ -48,7 +48,7 @@ class Estimate:
 
 @dataclass(frozen=True)
 class Curve:
-    """H_mid/L against dW/L with a pointwise error bar (arrays of equal length, dW increasing), and
+    """A quantity (H_mid/L, or the clamp force F_shear L/(E b^3)) against dW/L with a pointwise error bar (arrays of equal length, dW increasing), and
     each point's observed order (nan where none) and whether its sequence was asymptotic."""
     dw: np.ndarray
     value: np.ndarray
@@ -75,7 +75,9 @@ class MeshResult:
 
 @dataclass(frozen=True)
 class Study:
-    """A model's mesh study of one scene (dL/L, W/L)."""
+    """A model's mesh study of one scene (dL/L, W/L): thresholds, the H_mid/L curve and the clamp
+    force's curve (`force`, F_shear L/(E b^3); None where the study has none), each converged value
+    with its error bar."""
     model: str
     compression_ratio: float
     width_ratio: float
@@ -85,6 +87,7 @@ class Study:
     curve: Curve | None
     source: str
     runs: list = field(default_factory=list, repr=False)   # in-memory runs (studies of the report's own runs)
+    force: Curve | None = None
 
     @property
     def finest(self) -> MeshResult:
@@ -95,8 +98,9 @@ class Study:
 
     def mesh_needed(self, key: str, accuracy: float, band: float = 0.02) -> MeshResult | None:
         """The coarsest mesh of the study whose distance to the extrapolated value plus the error
-        bar of that value is within `accuracy` (key "dW1", "dW2", or "curve": the largest over dW
-        `band` away from both thresholds); None when no mesh of the study is."""
+        bar of that value is within `accuracy` (key "dW1", "dW2", "curve": the largest over dW
+        `band` away from both thresholds, or "force": the same for the clamp force relative to its
+        largest |F| there); None when no mesh of the study is."""
         for k, mesh in enumerate(self.meshes):
             error = self.mesh_error(k, key, band)
             if error is not None and error <= accuracy:
@@ -111,16 +115,18 @@ class Study:
                 return None
             return abs(ours - estimate.value) + estimate.error_bar
         run = self.runs[k] if k < len(self.runs) else (StoredRun(mesh.folder) if mesh.folder else None)
-        if run is None or self.curve is None:
+        curve, column = (self.force, "F_shear_norm") if key == "force" else (self.curve, "H_mid_over_L")
+        if run is None or curve is None:
             return None
         rows = [r for r in run.rows if r["stage"] == "shear"]
-        dw, h = np.array([r["dW_over_L"] for r in rows]), np.array([r["H_mid_over_L"] for r in rows])
-        keep = away_from(self.curve.dw, self.thresholds(), band) & (self.curve.dw <= dw.max())
+        dw, h = np.array([r["dW_over_L"] for r in rows]), np.array([r[column] for r in rows], float)
+        keep = away_from(curve.dw, self.thresholds(), band) & (curve.dw <= dw.max())
         if not np.any(keep):
             return None
         order = np.argsort(dw)
-        diff = np.abs(np.interp(self.curve.dw[keep], dw[order], h[order]) - self.curve.value[keep])
-        return float(np.max(diff + self.curve.error_bar[keep]))
+        diff = np.abs(np.interp(curve.dw[keep], dw[order], h[order]) - curve.value[keep])
+        scale = float(np.max(np.abs(curve.value[keep]))) if key == "force" else 1.0   # the force: relative
+        return float(np.max(diff + curve.error_bar[keep])) / scale if scale > 0 else None
 
     def u_branch_orders(self, start: float = 0.05, band: float = 0.02) -> tuple[np.ndarray, int]:
         """Observed orders of H_mid at the asymptotic points of the U branch (start < dW/L < dW1 -
@@ -183,7 +189,8 @@ def load_study(model: str, compression_ratio: float, width_ratio: float, root: P
     scene = data["scene"]
     return Study(model, float(scene["compression_ratio"]), float(scene["width_ratio"]), meshes,
                  Estimate.of(data.get("dW1")), Estimate.of(data.get("dW2")), _curve(data.get("H_mid_curve")),
-                 str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path))
+                 str(path.relative_to(ROOT)) if path.is_relative_to(ROOT) else str(path),
+                 force=_curve(data.get("F_shear_curve")))
 
 
 def study_from_runs(model: str, runs, resolutions, unit: str = "elements") -> Study | None:
@@ -204,17 +211,23 @@ def study_from_runs(model: str, runs, resolutions, unit: str = "elements") -> St
               for n, r in zip(resolutions, runs)]
     return Study(model, float(scene["compression_ratio"]), float(scene["width_ratio"]), meshes,
                  Estimate.of(estimates.get("dW1")), Estimate.of(estimates.get("dW2")),
-                 _curve(estimates.get("H_mid_curve")), "runs of this report", runs=list(runs))
+                 _curve(estimates.get("H_mid_curve")), "runs of this report", runs=list(runs),
+                 force=_curve(estimates.get("F_shear_curve")))
 
 
-def single_run_study(model: str, run, error_of) -> Study:
-    """One run as a study whose curve's error bar is borrowed: `error_of(dw)` gives the pointwise
-    error bar (e.g. the same mesh's measured error for the nu = 0 shell, for the shell with the
-    plate's material, data/fem_dep, which has one mesh only). Thresholds carry no error bar."""
+def single_run_study(model: str, run, error_of, force_error_of=None) -> Study:
+    """One run as a study whose curves' error bars are borrowed: `error_of(dw)` gives the pointwise
+    error bar of H_mid (e.g. the same mesh's measured error for the nu = 0 shell, for the shell with
+    the plate's material, data/fem_dep, which has one mesh only), `force_error_of(dw)` that of the
+    clamp force (no force curve without it). Thresholds carry no error bar."""
     rows = [r for r in run.rows if r["stage"] == "shear"]
     order = np.argsort([r["dW_over_L"] for r in rows])
     dw = np.array([rows[i]["dW_over_L"] for i in order])
     value = np.array([rows[i]["H_mid_over_L"] for i in order])
+    force = None
+    if force_error_of is not None:
+        f = np.array([rows[i]["F_shear_norm"] for i in order], float)
+        force = Curve(dw, f, np.asarray(force_error_of(dw), float))
     scene = run.summary["scene"]
     resolution = int(scene.get("resolution") or 0)
     mesh = MeshResult(f"N{resolution}", resolution, "elements along L", run.summary.get("dW1_over_L"),
@@ -223,4 +236,4 @@ def single_run_study(model: str, run, error_of) -> Study:
                  None if mesh.dW1 is None else Estimate(mesh.dW1, None),
                  None if mesh.dW2 is None else Estimate(mesh.dW2, None),
                  Curve(dw, value, np.asarray(error_of(dw), float)), str(getattr(run, "directory", "run")),
-                 runs=[run])
+                 runs=[run], force=force)

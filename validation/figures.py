@@ -148,11 +148,24 @@ def _legend(ax, size: float = 6.5, outside: bool = False, others=()) -> None:
         ax.legend(list(seen.values()), list(seen), fontsize=size, framealpha=0.85, loc="best")
 
 
+#: Shading of the mesh studies' converged curves
+BAND_COLORS = {"fem (converged)": "0.35", "plate (converged)": "tab:orange"}
+
+
 def shear_force(rows: list[dict], panels: list[tuple[float, float]], thresholds: list[dict]):
+    """Runs' forces as curves; the rows of a mesh study's converged force (model "... (converged)",
+    with error_bar) as a band of +- the error bar."""
     plt = _pyplot()
-    fig, axes = _panel_grid(plt, len(panels), len(panels), (4.5, 3.4))
+    fig, axes = _panel_grid(plt, len(panels), min(2, len(panels)), (4.8, 3.4))
+    studies = [r for r in rows if str(r["model"]).endswith("(converged)")]
+    runs = [r for r in rows if not str(r["model"]).endswith("(converged)")]
     for ax, (compression, width) in zip(axes, panels):
-        _shear_panel(ax, _in_panel(rows, compression, width), "F_shear_norm", _in_panel(thresholds, compression, width))
+        for (model,), sel in _groups(_in_panel(studies, compression, width), "model"):
+            dw = np.array([b["dW_over_L"] for b in sel])
+            v, e = np.array([b["F_shear_norm"] for b in sel]), np.array([b["error_bar"] for b in sel])
+            ax.fill_between(dw, v - e, v + e, color=BAND_COLORS.get(model, "gray"), alpha=0.3, lw=0,
+                            label=f"{model} +- error bar")
+        _shear_panel(ax, _in_panel(runs, compression, width), "F_shear_norm", _in_panel(thresholds, compression, width))
         ax.set_yscale("symlog", linthresh=1.0)
         ax.set_title(f"W/L = {fraction(width)}, dL/L = {fraction(compression)}", fontsize=9)
         ax.set_xlabel("dW/L")

@@ -167,6 +167,8 @@ def main(argv=None) -> int:
     parser.add_argument("--levels", type=int, default=LEVELS)
     parser.add_argument("--quiet", action="store_true")
     parser.add_argument("--model", choices=sorted(MODELS), default="plate")
+    parser.add_argument("--studies-only", action="store_true",
+                        help="no run: rewrite each selected scene's study and the index from its finished runs")
     args = parser.parse_args(argv)
     known = [name for name, _, _, _ in all_scenes()]
     paper = {name for name, _, _ in scenes()}
@@ -184,6 +186,10 @@ def main(argv=None) -> int:
     for name, compression, width, slenderness in all_scenes():
         if (args.only and name not in args.only) or (not args.only and name not in paper):
             continue  # the error map's scenes (fem_reference.gold.MAP_SCENES) run only when named
+        if args.studies_only:
+            if (out / name).is_dir():
+                write_scene_study(out / name, rows_sequence(width, args.levels), args.model)
+            continue
         status = run_scene(out, name, compression, width, args.levels, args.quiet, args.model,
                            slenderness) or status
     write_index(out, args.model)

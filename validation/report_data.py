@@ -240,21 +240,38 @@ def shear_curve_figures(results, profile, golds) -> list[FigureData]:
     return figures
 
 
-def shear_force_figure(results, profile, golds) -> FigureData | None:
-    """Lateral clamp force against dW/L on the narrow and the 1/6 scene (paper Fig. E.18)."""
-    scenes = [s for s in ((0.5, 1 / 20), (0.5, 1 / 6)) if s in profile.shear_curves]
+#: The scenes of the force figure (paper Fig. E.18: dL/L = 1/2, W/L = 1/20, 1/12, 1/6, 1/2)
+FORCE_SCENES = tuple((0.5, w) for w in (1 / 20, 1 / 12, 1 / 6, 1 / 2))
+
+
+def shear_force_figure(results, profile, golds, load=None) -> FigureData | None:
+    """Lateral clamp force against dW/L on the paper's Fig. E.18 scenes the profile runs, with
+    the converged force of the FEM and plate mesh studies where they exist (rows of model "fem
+    (converged)", "plate (converged)" with their error_bar; `load(model, dL/L, W/L)`, default
+    validation.estimates.load_study)."""
+    load = load or load_study
+    scenes = [s for s in FORCE_SCENES if s in profile.shear_curves]
     if not scenes:
         return None
     rows, thresholds = [], []
     for compression, width in scenes:
         r, t = shear_column(results, profile, golds, compression, width, "F_shear_norm")
-        rows += r
+        rows += [row + [None] for row in r]
         thresholds += t
+        for model in ("fem", "plate"):
+            study = load(model, compression, width)
+            if study is not None and study.force is not None:
+                f = study.force
+                rows += [[f"{model} (converged)", compression, width, float(x), float(v), float(e)]
+                         for x, v, e in zip(f.dw, f.value, f.error_bar)]
     return FigureData(
         "shear_force", "shear_force",
-        "Lateral clamp force against dW/L (paper Fig. E.18); dotted: dW1, dashed: dW2 of each model (from "
-        "stability). tests/test_shear_force.py checks the force against the derivative of the energy along the path.",
-        ["model", "compression_ratio", "width_ratio", "dW_over_L", "F_shear_norm"], rows,
+        "Lateral clamp force against dW/L (paper Fig. E.18), on a symlog axis (linear for |F| L/(E b^3) < 1, "
+        "logarithmic beyond: the force grows without bound as dW approaches dW_max); dotted: dW1, dashed: dW2 of "
+        "each model (from stability); shaded: the converged force of the FEM and plate mesh studies with its error "
+        "bar, up to where all their meshes reached (claims plate_vs_fem_force, plate_vs_fem_own_material_force). "
+        "tests/test_shear_force.py checks the force against the derivative of the energy along the path.",
+        ["model", "compression_ratio", "width_ratio", "dW_over_L", "F_shear_norm", "error_bar"], rows,
         {"panels": scenes, "thresholds": thresholds})
 
 
@@ -752,18 +769,22 @@ def rod_study(results, profile) -> Study | None:
 
 
 def dep_material_study(fem) -> Study | None:
-    """The FEM shell with the plate's material (data/fem_dep, one mesh) as a study whose error bar
-    is the measured error of the nu = 0 shell on the same mesh (data/fem_fine against the FEM gold
-    study's converged curve); None where any is missing."""
+    """The FEM shell with the plate's material (data/fem_dep, one mesh) as a study whose error bars
+    (H_mid and the clamp force) are the measured errors of the nu = 0 shell on the same mesh
+    (data/fem_fine against the FEM gold study's converged curves); None where any is missing."""
     dep, iso_dir = load_dep_material(), FEM_FINE / "dL0.5_W0.1667_N90"
     if dep is None or fem is None or fem.curve is None or not (iso_dir / "summary.json").exists():
         return None
-    iso = single_run_study("fem", GoldCurve(iso_dir), lambda dw: np.zeros_like(dw))
+    zero = lambda dw: np.zeros_like(dw)  # noqa: E731
+    iso = single_run_study("fem", GoldCurve(iso_dir), zero, zero)
 
     def error_of(dw):
         return np.abs(np.interp(dw, iso.curve.dw, iso.curve.value) - np.interp(dw, fem.curve.dw, fem.curve.value))
 
-    return single_run_study("fem", dep, error_of)
+    def force_error_of(dw):  # the same for the clamp force, where the gold study has its force curve
+        return np.abs(np.interp(dw, iso.force.dw, iso.force.value) - np.interp(dw, fem.force.dw, fem.force.value))
+
+    return single_run_study("fem", dep, error_of, force_error_of if fem.force is not None else None)
 
 
 def evaluate_claims(results, profile, golds) -> list[dict]:

@@ -290,7 +290,10 @@ Error bars (fem_reference.convergence.estimate): with three meshes whose differe
 monotonically and an observed order p in [1, 4], the value is the Richardson extrapolation and
 the error bar 1.25 |f3 - f2| / (r^p - 1) (Roache's grid convergence index on the finest mesh); otherwise
 the value is the finest mesh's, the error bar the spread of the finest two |f3 - f2| (times 3
-when the differences do not shrink), flagged "not asymptotic".
+when the differences do not shrink), flagged "not asymptotic". The same estimate is made at every
+recorded dW of the common grid for H_mid/L (richardson.json `H_mid_curve`) and for the clamp
+force F_shear L/(E b^3) (`F_shear_curve`), up to the smallest dW all meshes reached.
+`--studies-only` rewrites the studies and this file from the stored runs without running any.
 
 ## What exists (written by the gold command)
 

@@ -157,3 +157,40 @@ def test_the_fig9_generator_refuses_a_bad_out_and_skips_finished_widths(tmp_path
     import ddg.analysis.curvatures as curvatures
     monkeypatch.setattr(curvatures, "states_at_shears", lambda *a, **k: 1 / 0)
     assert pf.write_fields(tmp_path / "out", quiet=True) == []
+    for width in pf.FIG9_WIDTHS:                     # Fig. 9a: a width with its centreline file is finished
+        pf.shape_files(tmp_path / "out", width)["centerline"].parent.mkdir(parents=True, exist_ok=True)
+        pf.shape_files(tmp_path / "out", width)["centerline"].write_text("dW_over_L\n")
+    assert pf.write_shapes(tmp_path / "out", quiet=True) == []
+
+
+def test_fig9a_draws_the_deformed_plate_and_its_centreline_rendering(tmp_path):
+    """A coarse plate (W/L = 1/6, 300 triangles) sheared to dW/L = 0.1: the shape files hold every
+    node of the mesh, the centreline runs through both clamps with its m2 at every station, and
+    the figure draws the mesh and the Eq. (12) lines from them (Fig. 9a)."""
+    pytest.importorskip("matplotlib")
+    import csv
+
+    import numpy as np
+
+    from validation import figures
+    from validation import paper_figures as pf
+    from validation.report_data import fig9a_figure
+
+    written = pf.write_shapes(tmp_path, widths=(1 / 6,), shears=(0.1,), triangles=300, quiet=True)
+    files = pf.shape_files(tmp_path, 1 / 6)
+    assert written == [files["centerline"]]
+    tri = np.loadtxt(files["triangles"], delimiter=",", skiprows=1, dtype=int)
+    with open(files["nodes"]) as f:
+        nodes = list(csv.DictReader(f))
+    assert len(nodes) == tri.max() + 1 and {n["dW_over_L"] for n in nodes} == {"0.1"}
+    with open(files["centerline"]) as f:
+        line = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+    assert line[0]["s_over_L"] <= 1e-9 and line[-1]["s_over_L"] >= 1 - 1e-9   # the clamped rows included
+    # m2 at a station is the mean of its two edges' unit m2 (Eq. 12): unit to within their turn
+    # (|m2| in [0.9953, 1] on the committed W/L = 1/3 shapes, 2000 triangles)
+    assert all(0.99 < np.hypot(np.hypot(r["m2_x"], r["m2_y"]), r["m2_z"]) <= 1 + 1e-6 for r in line)
+    figure = fig9a_figure(tmp_path)
+    assert {r[0] for r in figure.rows} == {"plate node", "centreline"} and len(figure.rows) == len(nodes) + len(line)
+    fig = figures.draw(figure)
+    assert len(fig.axes) == 1 and fig.axes[0].get_title() == "W/L = 1/6, dW/L = 0.1"
+    assert fig9a_figure(tmp_path / "none") is None

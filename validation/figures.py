@@ -493,6 +493,52 @@ def centerline_error_field(rows: list[dict]):
     return fig
 
 
+def deformed_plates(rows: list[dict], triangles: dict, stations_drawn: int = 12):
+    """Fig. 9a: the plate's deformed mesh (blue) and its centreline rendering (red: the centreline,
+    and at `stations_drawn` stations the line x + w m2, -W/2 <= w <= W/2, that Eq. (12) puts
+    across the width), a row of panels per W/L, a column per dW/L; equal axes."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+    plt = _pyplot()
+    widths = sorted({r["W_over_L"] for r in rows})
+    shears = sorted({r["dW_over_L"] for r in rows})
+    fig = plt.figure(figsize=(4.6 * len(shears), 2.7 * len(widths)))
+    for i, width in enumerate(widths):
+        tri = np.asarray(triangles[width], dtype=int)
+        edges = np.unique(np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1), axis=0)
+        for j, shear in enumerate(shears):
+            sel = [r for r in rows if r["W_over_L"] == width and r["dW_over_L"] == shear]
+            nodes = sorted((r for r in sel if r["kind"] == "plate node"), key=lambda r: r["index"])
+            line = sorted((r for r in sel if r["kind"] == "centreline"), key=lambda r: r["index"])
+            if not nodes or not line:
+                continue
+            xyz = np.array([[r["x_over_L"], r["y_over_L"], r["z_over_L"]] for r in nodes])
+            c = np.array([[r["x_over_L"], r["y_over_L"], r["z_over_L"]] for r in line])
+            m2 = np.array([[r["m2_x"], r["m2_y"], r["m2_z"]] for r in line])
+            ax = fig.add_subplot(len(widths), len(shears), i * len(shears) + j + 1, projection="3d")
+            ax.add_collection3d(Line3DCollection(xyz[edges], colors="tab:blue", linewidths=0.25, alpha=0.7,
+                                                 label="plate (DEP mesh)"))
+            ax.plot(c[:, 0], c[:, 1], c[:, 2], "-", color="crimson", lw=1.4, label="centreline")
+            pick = np.unique(np.linspace(0, len(c) - 1, stations_drawn).round().astype(int))
+            across = np.stack([c[pick] - 0.5 * width * m2[pick], c[pick] + 0.5 * width * m2[pick]], axis=1)
+            ax.add_collection3d(Line3DCollection(across, colors="crimson", linewidths=1.0,
+                                                 label="x + w m2 (Eq. 12)"))
+            lo, hi = xyz.min(axis=0), xyz.max(axis=0)
+            for setter, a, b in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), lo, hi):
+                setter(a, b)
+            ax.set_box_aspect(np.maximum(hi - lo, 0.02))
+            ax.view_init(elev=28, azim=-62)
+            ax.set_title(f"W/L = {fraction(width)}, dW/L = {shear:g}", fontsize=9)
+            ax.tick_params(labelsize=5, pad=0)
+            ax.set_xlabel("x/L", fontsize=6, labelpad=-8)
+            ax.set_ylabel("y/L", fontsize=6, labelpad=-8)
+            ax.set_zlabel("z/L", fontsize=6, labelpad=-8)
+            if i == 0 and j == 0:
+                ax.legend(fontsize=6, loc="upper left")
+    fig.tight_layout()
+    return fig
+
+
 A11_STYLES = {"rod": ("tab:blue", "-"), "plate": ("tab:orange", "-"), "ribbon_direct": ("tab:green", "--"),
               "ribbon_rod": ("tab:red", ":")}
 
@@ -517,7 +563,8 @@ def sadowsky_a11(rows: list[dict]):
 
 
 DRAW = {"elastica": elastica, "centerline_error": centerline_error, "curvature_profiles": curvature_profiles,
-        "sadowsky_a11": sadowsky_a11, "centerline_error_field": centerline_error_field, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
+        "sadowsky_a11": sadowsky_a11, "centerline_error_field": centerline_error_field,
+        "deformed_plates": deformed_plates, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
         "convergence": convergence, "poisson": poisson, "speed_accuracy": speed_accuracy,
         "stability_map": stability_map, "snapshots": snapshots, "wide_ribbons": wide_ribbons}
 

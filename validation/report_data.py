@@ -620,6 +620,37 @@ def error_map_rows(path: Path | None = None) -> list[dict]:
     return read_table(path) if path.exists() else []
 
 
+def fig9a_figure(folder: Path) -> FigureData | None:
+    """Fig. 9a from its files under `folder` (the paper figures' data folder, with fig9a/ written by
+    validation/paper_figures.py: write_shapes): the rows are the plate's
+    deformed nodes and the centreline stations with their m2; the meshes' triangles are marks.
+    None without any finished width."""
+    from ddg.output.io import read_numeric_rows
+
+    from .paper_figures import FIG9_WIDTHS, shape_files
+
+    columns = ["kind", "W_over_L", "dW_over_L", "index", "x_over_L", "y_over_L", "z_over_L", "m2_x", "m2_y", "m2_z"]
+    rows, triangles = [], {}
+    for width in FIG9_WIDTHS:
+        files = shape_files(folder, width)
+        if not files["centerline"].exists():
+            continue
+        w = round(width, 6)
+        triangles[w] = [[int(r["i"]), int(r["j"]), int(r["k"])] for r in read_numeric_rows(files["triangles"])]
+        rows += [["plate node", w, r["dW_over_L"], int(r["node"]), r["x_over_L"], r["y_over_L"], r["z_over_L"],
+                  None, None, None] for r in read_numeric_rows(files["nodes"])]
+        rows += [["centreline", w, r["dW_over_L"], k, r["x_over_L"], r["y_over_L"], r["z_over_L"], r["m2_x"],
+                  r["m2_y"], r["m2_z"]] for k, r in enumerate(read_numeric_rows(files["centerline"]))]
+    if not rows:
+        return None
+    return FigureData(
+        "deformed_plates", "deformed_plates",
+        "Deformed plates and their centreline rendering (paper Fig. 9a): the plate on 2000 triangles (blue mesh) "
+        "and the centreline with, at 12 stations, the line x + w m2 across the width that Eq. (12) builds from it "
+        "(red), at dL/L = 1/2; rows W/L, columns dW/L; equal axes. Fig. 9b gives the distance between the two "
+        "(`python -m validation.paper_figures`, data/paper_figures/fig9a).", columns, rows, {"triangles": triangles})
+
+
 def paper_figures(folder: Path | None = None) -> list[FigureData]:
     """The figures after the paper's Fig. 10 (the centreline approximation, Eq. 13) and Figs.
     A.12-14 (curvature profiles) from their committed data (data/paper_figures/generate.sh); the
@@ -639,6 +670,9 @@ def paper_figures(folder: Path | None = None) -> list[FigureData]:
             "The plate's centreline against the best centreline of a rod (paper Fig. 10, Eq. 13): mean and largest "
             "deviation delta in % of L against L/W on a log axis (L/W = 20 at the right), one line per dW/L; "
             "plate on 2000 triangles, dL/L = 1/2 (`python -m ddg centerline-error`, data/paper_figures).", rows))
+    shapes = fig9a_figure(folder)
+    if shapes is not None:
+        out.append(shapes)
     fields = []
     for path in sorted((folder / "fig9").glob("W*.csv")) if (folder / "fig9").is_dir() else []:
         fields += read_numeric_rows(path)

@@ -32,5 +32,6 @@ for width in 0.05 0.1667; do
     fi
   done
 done
-# Fig. 9b: the centreline approximation's error delta(s, w) over the plate (validation/paper_figures.py)
+# Fig. 9a (the deformed plates and their centreline rendering) and Fig. 9b (the centreline approximation's
+# error delta(s, w) over the plate): validation/paper_figures.py
 $PY -m validation.paper_figures --out $OUT --quiet

@@ -682,3 +682,33 @@ def test_the_ribbon_and_error_map_sections_render_from_the_map():
             assert _html_row(row, table.shown_columns) in page, (table.name, row)
     assert "## 1D models with width" in md and "## Which model is enough (error map)" in md
     assert "1 of 2 scenes have a model within 0.01 L on all three; 2 on dW1 alone." in md
+
+
+def test_the_force_comparison_is_relative_to_the_reference_force_and_split_by_range():
+    """curve_agreement(quantity="force") divides the differences and error bars by the FEM's largest
+    |F| on the compared points; force_table gives the whole path and the U branch per scene (a plate
+    10 % above the FEM on U with 1 % error bars: difference 0.1 of the scale, excess 0.08)."""
+    import numpy as np
+
+    from validation.estimates import Curve, Estimate, MeshResult, Study
+    from validation.report_data import force_table
+
+    dw = np.linspace(0.0, 0.6, 61)
+    fem_force = 2.0 * dw
+    plate_force = np.where(dw < 0.3, 1.1 * fem_force, fem_force)
+
+    def study(model, force):
+        return Study(model, 0.5, 1 / 6, [MeshResult("m", 1, "elements", 0.305, 0.5)], Estimate(0.305, 0.001),
+                     Estimate(0.5, 0.001), Curve(dw, 0.3 + 0 * dw, 0 * dw), "synthetic",
+                     force=Curve(dw, force, 0.01 * np.abs(fem_force)))
+
+    plate, fem = study("plate", plate_force), study("fem", fem_force)
+    u = C.curve_agreement(plate, fem, band=0.0, upto=0.285, quantity="force")
+    assert u.difference == pytest.approx(0.1) and u.points == 29
+    assert u.combined_error_bar == pytest.approx(0.02) and u.excess == pytest.approx(0.08)
+    rows = force_table(load=lambda model, c, w: {"plate": plate, "fem": fem}[model] if (c, w) == (0.5, 1 / 6)
+                       else None)
+    assert [r["range"] for r in rows] == ["path, 0.02 from the thresholds", "U branch"]
+    whole, ub = rows
+    assert ub["F_scale"] == pytest.approx(2 * 0.28, rel=1e-3) and ub["excess"] == pytest.approx(0.08)
+    assert whole["F_scale"] == pytest.approx(1.2, rel=1e-3) and whole["points"] < 61

@@ -165,13 +165,22 @@ def shear_force(rows: list[dict], panels: list[tuple[float, float]], thresholds:
             v, e = np.array([b["F_shear_norm"] for b in sel]), np.array([b["error_bar"] for b in sel])
             ax.fill_between(dw, v - e, v + e, color=BAND_COLORS.get(model, "gray"), alpha=0.3, lw=0,
                             label=f"{model} +- error bar")
-        _shear_panel(ax, _in_panel(runs, compression, width), "F_shear_norm", _in_panel(thresholds, compression, width))
+        mine = _in_panel(runs, compression, width)
+        _shear_panel(ax, mine, "F_shear_norm", _in_panel(thresholds, compression, width))
         ax.set_yscale("symlog", linthresh=1.0)
+        # the bands (and a non-asymptotic extrapolation) may dip far below zero where an error bar
+        # exceeds the force (near dW_max): the axis stops a little below the runs' lowest force
+        lowest = min([0.0] + [float(r["F_shear_norm"]) for r in mine])
+        ax.set_ylim(bottom=lowest - 0.2)
         ax.set_title(f"W/L = {fraction(width)}, dL/L = {fraction(compression)}", fontsize=9)
         ax.set_xlabel("dW/L")
         ax.set_ylabel("F_shear L/(E b^3)\n(symlog: linear for |F| < 1, log beyond)", fontsize=8)
-        _legend(ax, 7)
-    fig.tight_layout()
+    seen = {}
+    for ax in axes:   # one legend for all panels, beside them
+        for h, label in zip(*ax.get_legend_handles_labels()):
+            seen.setdefault(label, h)
+    fig.tight_layout(rect=(0, 0, 0.8, 1))
+    fig.legend(list(seen.values()), list(seen), fontsize=7, loc="center left", bbox_to_anchor=(0.8, 0.5))
     return fig
 
 

@@ -275,6 +275,40 @@ def shear_force_figure(results, profile, golds, load=None) -> FigureData | None:
         {"panels": scenes, "thresholds": thresholds})
 
 
+FORCE_COLUMNS = ["reference", "compression_ratio", "width_ratio", "range", "points", "F_scale", "difference",
+                 "combined_error_bar", "excess", "worst_at_dW_over_L"]
+
+
+def force_table(dep6=None, load=None) -> list[dict]:
+    """The plate study's clamp force against the FEM's on the scenes of claim plate_vs_fem_force
+    (and against the shell with the plate's material, `dep6`, at W/L = 1/6), split by range: the
+    whole compared path (0.02 from the thresholds, as the claim) and the U branch (up to 0.02 below
+    the smaller dW1); figures relative to the FEM's largest |F| on the compared points. A scene
+    without both studies is left out."""
+    load = load or load_study
+    pairs = [("FEM study", c, w, load("plate", c, w), load("fem", c, w))
+             for c, w in [SPEED_SCENE, *C.NARROW_SCENES]]
+    if dep6 is not None:
+        pairs.append(("FEM, plate's material (90 el.)", *SPEED_SCENE, load("plate", *SPEED_SCENE), dep6))
+    out = []
+    for reference, c, w, plate, fem in pairs:
+        if plate is None or fem is None or plate.force is None or fem.force is None:
+            continue
+        dw1 = min(x.value for x in (plate.dW1, fem.dW1) if x is not None) if plate.dW1 or fem.dW1 else None
+        ranges = [("path, 0.02 from the thresholds", C.curve_agreement(plate, fem, quantity="force"))]
+        if dw1 is not None:
+            ranges.append(("U branch", C.curve_agreement(plate, fem, band=0.0, upto=dw1 - C.THRESHOLD_BAND,
+                                                         quantity="force")))
+        for name, a in ranges:
+            if a is not None:   # a.where: "<scene> dW/L = <x>, max |F| <scale>"
+                at, scale = a.where.split(" dW/L = ")[-1].split(", max |F| ")
+                out.append({"reference": reference, "compression_ratio": c, "width_ratio": w, "range": name,
+                            "points": a.points, "F_scale": float(scale), "difference": a.difference,
+                            "combined_error_bar": a.combined_error_bar, "excess": a.excess,
+                            "worst_at_dW_over_L": float(at)})
+    return out
+
+
 def threshold_table(results, profile, golds) -> list[dict]:
     """dW1, dW2, dW2_S_stable per model and scene, against the paper's quoted values and drops."""
     table = []
@@ -896,6 +930,7 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
     figures.append(_records_figure("stability_map", "stability_map",
                                    "Where each model fails and how (marker size: share of dW_max reached).", smap))
     claims = evaluate_claims(results, profile, golds)
+    forces = force_table(dep_material_study(load_study("fem", *SPEED_SCENE)))
     snapshot_figure, snapshots = snapshot_data(results, profile)
     if snapshot_figure is not None:
         figures.append(snapshot_figure)
@@ -910,6 +945,8 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
                                shown=[c for c in smap_columns if c != "message"]),
         "benchmark": bench,
     }
+    if forces:
+        tables["force"] = Table("force", FORCE_COLUMNS, forces, csv=True)
     map_rows = error_map_rows()
     if map_rows:
         wide = wide_ribbon_table(map_rows)

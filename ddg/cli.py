@@ -247,6 +247,37 @@ def cmd_curvatures(args) -> int:
     return 0
 
 
+def centerline_error_figure(rows: list[dict], shears):
+    """Fig. 10 of `ddg centerline-error`: mean (solid) and largest (dotted) delta of Eq. (13) in %
+    of L against L/W, one colour per dW/L, on log axes (a linear one hides L/W = 20 and the
+    narrow strips' errors); the y axis stays linear if an error is zero."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5.4, 3.8))
+    positive = True
+    for k, shear in enumerate(shears):   # Fig. 10: mean (solid) and largest (dotted) delta, log axes
+        mine = sorted((r for r in rows if abs(r["dW_over_L"] - shear) < 1e-9 and r["mean_error"] == r["mean_error"]),
+                      key=lambda r: r["L_over_W"])
+        lw = [r["L_over_W"] for r in mine]
+        ax.plot(lw, [100 * r["mean_error"] for r in mine], "o-", color=f"C{k}", label=f"dW/L = {shear:g}, mean")
+        ax.plot(lw, [100 * r["max_error"] for r in mine], "s:", color=f"C{k}", ms=3, label=f"dW/L = {shear:g}, max")
+        positive &= all(r["mean_error"] > 0 for r in mine)
+    ax.set_xscale("log")
+    ticks = sorted({r["L_over_W"] for r in rows})
+    ax.set_xticks(ticks, [f"{t:.3g}" for t in ticks])
+    ax.xaxis.set_minor_formatter(plt.NullFormatter())
+    if positive:
+        ax.set_yscale("log")
+    ax.set_xlabel("L / W (log)")
+    ax.set_ylabel(r"$\delta$ (% of L), Eq. (13)")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    return fig
+
+
 def cmd_centerline_error(args) -> int:
     """Fig. 10: OUT/centerline_error.csv (mean and max of Eq. 13 per W/L and dW/L) and a PNG."""
     import csv
@@ -278,20 +309,10 @@ def cmd_centerline_error(args) -> int:
     writer.writeheader()
     writer.writerows(rows)
     atomic_write_text(out / "centerline_error.csv", buf.getvalue())
-    import matplotlib
-
-    matplotlib.use("Agg")
+    fig = centerline_error_figure(rows, shears)
+    fig.savefig(out / "centerline_error.png", dpi=120)
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(5.0, 3.6))
-    for shear in shears:
-        mine = sorted((r for r in rows if abs(r["dW_over_L"] - shear) < 1e-9), key=lambda r: r["L_over_W"])
-        ax.plot([r["L_over_W"] for r in mine], [100 * r["mean_error"] for r in mine], "o-", label=f"dW/L = {shear:g}")
-    ax.set_xlabel("L / W")
-    ax.set_ylabel(r"mean $\delta$ (% of L), Eq. (13)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / "centerline_error.png", dpi=120)
     plt.close(fig)
     for r in rows:
         print(f"L/W = {r['L_over_W']:.3g}  dW/L = {r['dW_over_L']:.3g}  mean {r['mean_error']:.3e}  max "

@@ -93,3 +93,18 @@ def test_centerline_error_command_writes_csv_and_png(tmp_path):
     assert float(rows[1]["mean_error"]) > float(rows[0]["mean_error"]) > 0
     assert (out / "centerline_error.png").stat().st_size > 1000
     assert main(["centerline-error", "--width-ratios", "1.5", "--out", str(tmp_path / "bad")]) == 2
+
+
+def test_the_centerline_error_figure_has_log_axes_and_skips_unreached_states():
+    """Fig. 10 as the command draws it: L/W and delta on log axes (L/W = 20 beside 2), mean and
+    max per dW/L; a state the run did not reach (NaN) is left out; a zero error keeps y linear."""
+    pytest.importorskip("matplotlib")
+    from ddg.cli import centerline_error_figure
+
+    rows = [{"L_over_W": lw, "dW_over_L": 0.1, "mean_error": e, "max_error": 3 * e}
+            for lw, e in ((2.0, 1e-2), (20.0, 1e-4), (6.0, float("nan")))]
+    ax = centerline_error_figure(rows, [0.1]).axes[0]
+    assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
+    assert [len(line.get_xdata()) for line in ax.get_lines()] == [2, 2]
+    rows[0]["mean_error"] = 0.0
+    assert centerline_error_figure(rows, [0.1]).axes[0].get_yscale() == "linear"

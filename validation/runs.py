@@ -24,6 +24,19 @@ ROOT = Path(__file__).resolve().parent.parent
 __all__ = ["Progress", "RunResult", "RunSpec", "code_version", "estimated_cost", "execute_one", "load", "run_all"]
 
 
+def execute_quietly(*args, **kwargs):
+    """execute_one without printing its ddg.ValidityWarning: each run's summary.json keeps them
+    (`warnings`), and the report reads them from there. `execute_one` is looked up in this module
+    at each call, so a test may replace it."""
+    import warnings
+
+    from ddg import ValidityWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ValidityWarning)
+        return execute_one(*args, **kwargs)
+
+
 def run_all(specs: list[RunSpec], cache: Path, jobs: int = 1, progress: bool = True,
             scheduler: str | None = None) -> dict[RunSpec, RunResult]:
     """Every spec's result, from the cache where present, else computed: as Dask tasks on a
@@ -41,8 +54,7 @@ def run_all(specs: list[RunSpec], cache: Path, jobs: int = 1, progress: bool = T
         except ValueError as exc:  # ddg.InputError: dask is missing; run here, one at a time
             sys.stderr.write(f"note: {exc}; running the report's runs in this process, one at a time\n")
             in_process = True
-    # `execute_one` is looked up here at each call, so a test may replace it in this module
-    outcome = run_cached(specs, cache, execute_one, workers=jobs, scheduler=scheduler, progress=progress,
+    outcome = run_cached(specs, cache, execute_quietly, workers=jobs, scheduler=scheduler, progress=progress,
                          in_process=in_process)
     if outcome.interrupted is not None:
         raise outcome.interrupted

@@ -686,24 +686,15 @@ def fig9a_figure(folder: Path) -> FigureData | None:
 
 
 def paper_figures(folder: Path | None = None) -> list[FigureData]:
-    """The figures after the paper's Fig. 10 (the centreline approximation, Eq. 13) and Figs.
-    A.12-14 (curvature profiles) from their committed data (data/paper_figures/generate.sh); the
-    ones whose data are missing are left out."""
+    """The figures after the paper's Figs. 9a, 9b and 10 (the centreline approximation, Eqs. 12-13),
+    A.11 and A.12-14 (curvature profiles) from their committed data (data/paper_figures/generate.sh),
+    in that order; the ones whose data are missing are left out."""
     from ddg.output.io import read_numeric_rows
 
     from .reference import ROOT
 
     folder = Path(folder) if folder is not None else ROOT / "data" / "paper_figures"
     out = []
-    errors = folder / "centerline_error" / "centerline_error.csv"
-    if errors.exists():
-        rows = [{k: r[k] for k in ("L_over_W", "W_over_L", "dW_over_L", "mean_error", "max_error", "phase")}
-                for r in read_numeric_rows(errors)]
-        out.append(_records_figure(
-            "centerline_error", "centerline_error",
-            "The plate's centreline against the best centreline of a rod (paper Fig. 10, Eq. 13): mean and largest "
-            "deviation delta in % of L against L/W on a log axis (L/W = 20 at the right), one line per dW/L; "
-            "plate on 2000 triangles, dL/L = 1/2 (`python -m ddg centerline-error`, data/paper_figures).", rows))
     shapes = fig9a_figure(folder)
     if shapes is not None:
         out.append(shapes)
@@ -717,6 +708,15 @@ def paper_figures(folder: Path | None = None) -> list[FigureData]:
             "each deformed plate node to where the centreline and its material frame put it (Eq. 12), in % of L, "
             "on the flat strip (s, w); rows W/L, columns dW/L; plate on 2000 triangles, dL/L = 1/2 "
             "(`python -m validation.paper_figures`, data/paper_figures/fig9).", fields))
+    errors = folder / "centerline_error" / "centerline_error.csv"
+    if errors.exists():
+        rows = [{k: r[k] for k in ("L_over_W", "W_over_L", "dW_over_L", "mean_error", "max_error", "phase")}
+                for r in read_numeric_rows(errors)]
+        out.append(_records_figure(
+            "centerline_error", "centerline_error",
+            "The plate's centreline against the best centreline of a rod (paper Fig. 10, Eq. 13): mean and largest "
+            "deviation delta in % of L against L/W on a log axis (L/W = 20 at the right), one line per dW/L; "
+            "plate on 2000 triangles, dL/L = 1/2 (`python -m ddg centerline-error`, data/paper_figures).", rows))
     profiles = []
     for model in ("rod", "ribbon", "plate"):
         path = folder / f"curvatures_{model}" / "curvatures.csv"

@@ -60,6 +60,13 @@ class Curve:
         """(value, error bar) linearly interpolated at dw (inside the curve's range)."""
         return np.interp(dw, self.dw, self.value), np.interp(dw, self.dw, self.error_bar)
 
+    def upto(self, last: float) -> Curve:
+        """The curve's points with dW/L <= last."""
+        keep = self.dw <= last + 1e-12
+        return Curve(self.dw[keep], self.value[keep], self.error_bar[keep],
+                     None if self.order is None else self.order[keep],
+                     None if self.asymptotic is None else self.asymptotic[keep])
+
 
 @dataclass(frozen=True)
 class MeshResult:

@@ -9,6 +9,7 @@ timings and the provenance. validation/report.py renders it (templates, CSV, sum
 from __future__ import annotations
 
 import base64
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -839,7 +840,8 @@ def rod_study(results, profile) -> Study | None:
 def dep_material_study(fem) -> Study | None:
     """The FEM shell with the plate's material (data/fem_dep, one mesh) as a study whose error bars
     (H_mid and the clamp force) are the measured errors of the nu = 0 shell on the same mesh
-    (data/fem_fine against the FEM gold study's converged curves); None where any is missing."""
+    (data/fem_fine against the FEM gold study's converged curves), up to where the gold study's
+    curves reach; None where any is missing."""
     dep, iso_dir = load_dep_material(), FEM_FINE / "dL0.5_W0.1667_N90"
     if dep is None or fem is None or fem.curve is None or not (iso_dir / "summary.json").exists():
         return None
@@ -852,7 +854,11 @@ def dep_material_study(fem) -> Study | None:
     def force_error_of(dw):  # the same for the clamp force, where the gold study has its force curve
         return np.abs(np.interp(dw, iso.force.dw, iso.force.value) - np.interp(dw, fem.force.dw, fem.force.value))
 
-    return single_run_study("fem", dep, error_of, force_error_of if fem.force is not None else None)
+    study = single_run_study("fem", dep, error_of, force_error_of if fem.force is not None else None)
+    # the borrowed error bars are measured only where the gold study has its curves (up to the
+    # smallest dW all its meshes reached): the study ends there
+    return dataclasses.replace(study, curve=study.curve.upto(fem.curve.dw[-1]),
+                               force=None if study.force is None else study.force.upto(fem.force.dw[-1]))
 
 
 def evaluate_claims(results, profile, golds) -> list[dict]:

@@ -71,6 +71,24 @@ def test_table_is_resumable_by_key_and_hashes(tmp_path):
         rows = list(csv.DictReader(fh))
     assert len(rows) == 2 and [r["dW1_bound"] for r in rows if r["model"] == "rod"] == ["0.02"]
     assert list(rows[0]) == list(em.COLUMNS)
+    assert {r["rules_version"] for r in rows} == {em.RULES_VERSION}
+
+
+def test_a_row_made_under_other_comparison_rules_is_recomputed(tmp_path, monkeypatch):
+    """A change of the rules that make a row (RULES_VERSION) makes every row stale, also those whose
+    run and reference did not change (the stored plate and FEM runs), and rows from before the
+    column existed."""
+    path = tmp_path / "map.csv"
+    row = {"scene": "dL0.5_W0.05_Lb1181", "model": "plate", "resolution": 8, "resolution_label": "R8",
+           "source_hash": "a", "reference_hash": "r"}
+    em.Table(path).put(row)
+    assert em.Table(path).current(("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
+    monkeypatch.setattr(em, "RULES_VERSION", "next")
+    assert not em.Table(path).current(("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
+    old = path.read_text().replace(",rules_version", "").replace(",2\n", "\n")
+    path.write_text(old)
+    monkeypatch.undo()
+    assert not em.Table(path).current(("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
 
 
 def _map_row(w, lb, model, label, wall, bound):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -250,7 +251,8 @@ def cmd_curvatures(args) -> int:
 def centerline_error_figure(rows: list[dict], shears):
     """Fig. 10 of `ddg centerline-error`: mean (solid) and largest (dotted) delta of Eq. (13) in %
     of L against L/W, one colour per dW/L, on log axes (a linear one hides L/W = 20 and the
-    narrow strips' errors); the y axis stays linear if an error is zero."""
+    narrow strips' errors); the y axis stays linear if an error is zero. The report draws its Fig. 10
+    with it too (validation.figures.centerline_error)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -259,8 +261,8 @@ def centerline_error_figure(rows: list[dict], shears):
     fig, ax = plt.subplots(figsize=(5.4, 3.8))
     positive = True
     for k, shear in enumerate(shears):   # Fig. 10: mean (solid) and largest (dotted) delta, log axes
-        mine = sorted((r for r in rows if abs(r["dW_over_L"] - shear) < 1e-9 and r["mean_error"] == r["mean_error"]),
-                      key=lambda r: r["L_over_W"])
+        mine = sorted((r for r in rows if abs(r["dW_over_L"] - shear) < 1e-9 and isinstance(r["mean_error"], float)
+                       and math.isfinite(r["mean_error"])), key=lambda r: r["L_over_W"])   # unreached: NaN/empty
         lw = [r["L_over_W"] for r in mine]
         ax.plot(lw, [100 * r["mean_error"] for r in mine], "o-", color=f"C{k}", label=f"dW/L = {shear:g}, mean")
         ax.plot(lw, [100 * r["max_error"] for r in mine], "s:", color=f"C{k}", ms=3, label=f"dW/L = {shear:g}, max")

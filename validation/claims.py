@@ -142,6 +142,8 @@ class Agreement:
     excess: float
     points: int = 1
     where: str = ""
+    at: float | None = None       # a curve's worst dW/L
+    scale: float = 1.0            # what the figures are relative to (a force curve: the reference's largest |F|)
 
     @property
     def in_error_bars(self) -> float:
@@ -194,7 +196,8 @@ def curve_agreement(a, b, band: float = THRESHOLD_BAND, upto: float | None = Non
     excess = diff - combined
     k = int(np.argmax(excess))
     where = f"{_scene(a)} dW/L = {dw[keep][k]:.4f}" + ("" if quantity == "H_mid" else f", max |F| {scale:.4g}")
-    return Agreement(float(diff.max()), float(combined.max()), float(max(excess[k], 0.0)), int(keep.sum()), where)
+    return Agreement(float(diff.max()), float(combined.max()), float(max(excess[k], 0.0)), int(keep.sum()), where,
+                     float(dw[keep][k]), scale)
 
 
 def u_branch_agreement(a, b, band: float = THRESHOLD_BAND) -> Agreement | None:

@@ -130,16 +130,19 @@ def shear_curves(rows: list[dict], panels: list[tuple[float, float]], thresholds
     return fig
 
 
+def _legend_entries(axes) -> dict:
+    """label -> handle over `axes`, one per label, in order of first appearance."""
+    seen = {}
+    for ax in axes:
+        for h, label in zip(*ax.get_legend_handles_labels()):
+            seen.setdefault(label, h)
+    return seen
+
+
 def _legend(ax, size: float = 6.5, outside: bool = False, others=()) -> None:
     """One entry per label (the threshold lines repeat them; `others`: more axes whose entries it
     shows too): where it hides least, or beside the axes."""
-    handles, labels = ax.get_legend_handles_labels()
-    for other in others:
-        more = other.get_legend_handles_labels()
-        handles, labels = list(more[0]) + list(handles), list(more[1]) + list(labels)
-    seen = {}
-    for h, label in zip(handles, labels):
-        seen.setdefault(label, h)
+    seen = _legend_entries([*others, ax])
     if not seen:
         return
     if outside:
@@ -175,10 +178,7 @@ def shear_force(rows: list[dict], panels: list[tuple[float, float]], thresholds:
         ax.set_title(f"W/L = {fraction(width)}, dL/L = {fraction(compression)}", fontsize=9)
         ax.set_xlabel("dW/L")
         ax.set_ylabel("F_shear L/(E b^3)\n(symlog: linear for |F| < 1, log beyond)", fontsize=8)
-    seen = {}
-    for ax in axes:   # one legend for all panels, beside them
-        for h, label in zip(*ax.get_legend_handles_labels()):
-            seen.setdefault(label, h)
+    seen = _legend_entries(axes)   # one legend for all panels, beside them
     fig.tight_layout(rect=(0, 0, 0.8, 1))
     fig.legend(list(seen.values()), list(seen), fontsize=7, loc="center left", bbox_to_anchor=(0.8, 0.5))
     return fig
@@ -417,26 +417,12 @@ def _rendered_snapshots(panels: list[dict], widths: list[float], cols: int):
 
 
 def centerline_error(rows: list[dict]):
-    """Fig. 10: mean (solid) and largest (dotted) delta of Eq. (13) in % of L against L/W (log axis),
-    one colour per dW/L."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(5.4, 3.8))
-    for k, ((shear,), sel) in enumerate(sorted(_groups(rows, "dW_over_L"))):
-        sel = sorted((r for r in sel if isinstance(r["mean_error"], float) and np.isfinite(r["mean_error"])),
-                     key=lambda r: r["L_over_W"])
-        if not sel:
-            continue
-        colour = f"C{k}"
-        x = [r["L_over_W"] for r in sel]
-        ax.plot(x, [100 * r["mean_error"] for r in sel], "o-", color=colour, label=f"dW/L = {shear:g}, mean")
-        ax.plot(x, [100 * r["max_error"] for r in sel], "^:", color=colour, label=f"dW/L = {shear:g}, max")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("L / W (log scale)")
-    ax.set_ylabel("delta (% of L), Eq. (13) (log scale)")
-    _legend(ax, 6.5)
-    fig.tight_layout()
-    return fig
+    """Fig. 10: drawn as `ddg centerline-error` draws it (ddg.cli.centerline_error_figure: mean and
+    largest delta of Eq. 13 in % of L against L/W on log axes, one colour per dW/L)."""
+    _pyplot()
+    from ddg.cli import centerline_error_figure
+
+    return centerline_error_figure(rows, sorted({r["dW_over_L"] for r in rows}))
 
 
 def curvature_profiles(rows: list[dict]):

@@ -35,75 +35,71 @@ def field_file(out: Path, width: float) -> Path:
     return Path(out) / "fig9" / f"W{width:.4g}.csv"
 
 
-def write_fields(out: Path, widths=FIG9_WIDTHS, shears=FIG9_SHEARS, triangles: int = FIG9_TRIANGLES,
-                 quiet: bool = False) -> list[Path]:
-    """Each width's delta field into its file (module docstring); returns the files written now."""
-    import ddg
-    from ddg.analysis.centerline_approx import centerline_error_field
-    from ddg.analysis.curvatures import states_at_shears
-    from ddg.output.io import atomic_write_text
-
-    written = []
-    for width in widths:
-        path = field_file(out, width)
-        if path.exists():
-            continue
-        strip = ddg.Strip.from_ratios(width, 0.5)
-        buf = io.StringIO()
-        buf.write(",".join(COLUMNS) + "\n")
-        for model, state in states_at_shears("plate", strip, 0.5, list(shears), triangles):
-            field = centerline_error_field(model, state.q)
-            shear = state.shear / strip.length
-            for s, w, d in zip(field["s_over_L"], field["w_over_L"], field["delta"]):
-                buf.write(f"{width:.6g},{shear:.6g},{s:.5g},{w:.5g},{100 * d:.4g}\n")
-            if not quiet:
-                print(f"W/L = {width:.4g}, dW/L = {shear:.3g}: mean delta {100 * field['mean']:.3g} %, max "
-                      f"{100 * field['max']:.3g} %", file=sys.stderr, flush=True)
-        atomic_write_text(path, buf.getvalue())
-        written.append(path)
-    return written
-
-
 def shape_files(out: Path, width: float) -> dict[str, Path]:
     folder = Path(out) / "fig9a"
     return {kind: folder / f"W{width:.4g}_{kind}.csv" for kind in ("triangles", "nodes", "centerline")}
 
 
-def write_shapes(out: Path, widths=FIG9_WIDTHS, shears=FIG9_SHEARS, triangles: int = FIG9_TRIANGLES,
-                 quiet: bool = False) -> list[Path]:
-    """Each width's deformed plates and centreline frames (Fig. 9a; module docstring); returns the
-    centreline files written now (a width whose centreline file exists is skipped)."""
+def write_figure9(out: Path, widths=FIG9_WIDTHS, shears=FIG9_SHEARS, triangles: int = FIG9_TRIANGLES,
+                  quiet: bool = False, parts=("fields", "shapes")) -> list[Path]:
+    """Each width's Fig. 9b field file and Fig. 9a shape files (module docstring), from one plate
+    path per width: a width whose files of `parts` all exist is skipped, and a width missing only
+    one part writes only that. Returns the files written now (a width's field file, its
+    centreline file)."""
     import ddg
-    from ddg.analysis.centerline_approx import centerline_frame
+    from ddg.analysis.centerline_approx import centerline_error_field, centerline_frame
     from ddg.analysis.curvatures import states_at_shears
     from ddg.output.io import atomic_write_text
 
     written = []
     for width in widths:
-        files = shape_files(out, width)
-        if files["centerline"].exists():
+        field_path, shapes = field_file(out, width), shape_files(out, width)
+        fields = "fields" in parts and not field_path.exists()
+        shaped = "shapes" in parts and not shapes["centerline"].exists()
+        if not (fields or shaped):
             continue
         strip = ddg.Strip.from_ratios(width, 0.5)
         L = strip.length
-        nodes, line = io.StringIO(), io.StringIO()
+        deltas, nodes, line = io.StringIO(), io.StringIO(), io.StringIO()
+        deltas.write(",".join(COLUMNS) + "\n")
         nodes.write("dW_over_L,node,x_over_L,y_over_L,z_over_L\n")
         line.write("dW_over_L,s_over_L,x_over_L,y_over_L,z_over_L,m2_x,m2_y,m2_z\n")
         mesh = None
         for model, state in states_at_shears("plate", strip, 0.5, list(shears), triangles):
-            mesh = model.mesh
-            shear = state.shear / L
-            for k, x in enumerate(model.positions(state.q) / L):
-                nodes.write(f"{shear:.6g},{k},{x[0]:.6g},{x[1]:.6g},{x[2]:.6g}\n")
-            frame = centerline_frame(model, state.q)
-            for s, x, m2 in zip(frame["s"] / L, frame["x"] / L, frame["m2_node"]):
-                line.write(f"{shear:.6g},{s:.6g},{x[0]:.6g},{x[1]:.6g},{x[2]:.6g},{m2[0]:.6g},{m2[1]:.6g},{m2[2]:.6g}\n")
-            if not quiet:
-                print(f"Fig. 9a: W/L = {width:.4g}, dW/L = {shear:.3g}", file=sys.stderr, flush=True)
-        atomic_write_text(files["triangles"], "i,j,k\n" + "".join(f"{a},{b},{c}\n" for a, b, c in mesh.triangles))
-        atomic_write_text(files["nodes"], nodes.getvalue())
-        atomic_write_text(files["centerline"], line.getvalue())
-        written.append(files["centerline"])
+            mesh, shear = model.mesh, state.shear / L
+            if fields:
+                field = centerline_error_field(model, state.q)
+                for s, w, d in zip(field["s_over_L"], field["w_over_L"], field["delta"]):
+                    deltas.write(f"{width:.6g},{shear:.6g},{s:.5g},{w:.5g},{100 * d:.4g}\n")
+                if not quiet:
+                    print(f"W/L = {width:.4g}, dW/L = {shear:.3g}: mean delta {100 * field['mean']:.3g} %, max "
+                          f"{100 * field['max']:.3g} %", file=sys.stderr, flush=True)
+            if shaped:
+                for k, x in enumerate(model.positions(state.q) / L):
+                    nodes.write(f"{shear:.6g},{k},{x[0]:.6g},{x[1]:.6g},{x[2]:.6g}\n")
+                frame = centerline_frame(model, state.q)
+                for s, x, m2 in zip(frame["s"] / L, frame["x"] / L, frame["m2_node"]):
+                    line.write(f"{shear:.6g},{s:.6g},{x[0]:.6g},{x[1]:.6g},{x[2]:.6g},"
+                               f"{m2[0]:.6g},{m2[1]:.6g},{m2[2]:.6g}\n")
+        if fields:
+            atomic_write_text(field_path, deltas.getvalue())
+            written.append(field_path)
+        if shaped:
+            atomic_write_text(shapes["triangles"], "i,j,k\n" + "".join(f"{a},{b},{c}\n" for a, b, c in mesh.triangles))
+            atomic_write_text(shapes["nodes"], nodes.getvalue())
+            atomic_write_text(shapes["centerline"], line.getvalue())   # last: it marks the width finished
+            written.append(shapes["centerline"])
     return written
+
+
+def write_fields(out: Path, **kw) -> list[Path]:
+    """Fig. 9b's files alone (write_figure9)."""
+    return write_figure9(out, parts=("fields",), **kw)
+
+
+def write_shapes(out: Path, **kw) -> list[Path]:
+    """Fig. 9a's files alone (write_figure9)."""
+    return write_figure9(out, parts=("shapes",), **kw)
 
 
 def main(argv=None) -> int:
@@ -119,8 +115,7 @@ def main(argv=None) -> int:
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    write_fields(Path(args.out), quiet=args.quiet)
-    write_shapes(Path(args.out), quiet=args.quiet)
+    write_figure9(Path(args.out), quiet=args.quiet)
     return 0
 
 

@@ -301,12 +301,11 @@ def force_table(dep6=None, load=None) -> list[dict]:
             ranges.append(("U branch", C.curve_agreement(plate, fem, band=0.0, upto=dw1 - C.THRESHOLD_BAND,
                                                          quantity="force")))
         for name, a in ranges:
-            if a is not None:   # a.where: "<scene> dW/L = <x>, max |F| <scale>"
-                at, scale = a.where.split(" dW/L = ")[-1].split(", max |F| ")
+            if a is not None:
                 out.append({"reference": reference, "compression_ratio": c, "width_ratio": w, "range": name,
-                            "points": a.points, "F_scale": float(scale), "difference": a.difference,
+                            "points": a.points, "F_scale": a.scale, "difference": a.difference,
                             "combined_error_bar": a.combined_error_bar, "excess": a.excess,
-                            "worst_at_dW_over_L": float(at)})
+                            "worst_at_dW_over_L": a.at})
     return out
 
 

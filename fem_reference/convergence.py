@@ -53,81 +53,151 @@ def extrapolate(values: np.ndarray, resolutions, default_order=2.0):
 #: Observed orders accepted as asymptotic by `estimate` (P2 elements: about 2 for displacements;
 #: a threshold, the zero of an eigenvalue, may converge at up to twice that).
 ASYMPTOTIC_ORDERS = (1.0, 4.0)
-#: Roache's safety factor of the grid convergence index for a three-mesh study.
+#: Roache's safety factor of the grid convergence index for a three-mesh study whose observed
+#: order is at least LOW_ORDER (Roache 1998: 1.25 where three meshes confirm the order)...
 GCI_SAFETY = 1.25
+#: ... and below it: a low observed order is not a confirmed one (extrapolating at order 0.75
+#: adds three times the finest difference), so Roache's factor for an unconfirmed order, 3.
+LOW_ORDER = 1.5
+GCI_SAFETY_LOW_ORDER = 3.0
+#: A sequence that is not asymptotic (differences of opposite sign, not shrinking, an order
+#: outside ASYMPTOTIC_ORDERS, or only two meshes) gets this many times the largest difference of
+#: its finest three meshes as its error bar (issue 28: at W/L = 1/6, dL/L = 1/2 the gold's 0.0010
+#: from |d2| alone was 3.5 times smaller than the distance to an independent mesh series).
+NON_ASYMPTOTIC_FACTOR = 3.0
+#: The rule's version, stored with every estimate (richardson.json "rule"): 1 the spread of the
+#: finest two and GCI 1.25 at any order (before issue 28), 2 the rule above.
+ERROR_BAR_RULE = 2
 
 
-def estimate(values, resolutions, tolerance: float = 0.0) -> dict | None:
-    """The converged value of one quantity from its values on meshes `resolutions` (elements
-    along L, increasing; None or nan where a mesh did not give it), with an honest error bar.
+def order_from_ratios(d1: float, d2: float, coarse_ratio: float, fine_ratio: float) -> float | None:
+    """The observed order p of three meshes refined by `coarse_ratio` then `fine_ratio` (sizes
+    h1 = coarse_ratio h2, h2 = fine_ratio h3), from their differences d1 = f2 - f1, d2 = f3 - f2
+    under the error model f = f* + C h^p: the root of
 
-    With the finest three meshes' differences d1 = f2 - f1, d2 = f3 - f2 of one sign, shrinking,
-    and the observed order p = log(d1/d2)/log(r) in ASYMPTOTIC_ORDERS: the Richardson
-    extrapolation f3 + d2/(r^p - 1), error bar GCI_SAFETY |d2|/(r^p - 1) (Roache's grid
-    convergence index of the finest mesh), asymptotic True. Otherwise the finest value, error bar
-    |d2| while the differences shrink and 3 max(|d1|, |d2|) when they do not, asymptotic False
-    (two meshes: the spread |d2|; one: no error bar). `tolerance` (the bisection bracket of a
-    threshold) is added to the error bar. None without any value."""
-    pairs = [(int(n), float(v)) for n, v in zip(resolutions, values) if v is not None and np.isfinite(v)]
-    if not pairs:
+        |d1 / d2| = r_f^p (r_c^p - 1) / (r_f^p - 1)
+
+    (Celik et al. 2008, J. Fluids Eng. 130, 078001, Eqs. 4-5; with equal ratios p = ln|d1/d2|/ln r).
+    None when the differences change sign, or are too small a ratio for any p > 0 (not
+    shrinking as a converging sequence would)."""
+    if not d1 * d2 > 0:
         return None
-    ns, fs = [n for n, _ in pairs], [f for _, f in pairs]
+    target, rc, rf = abs(d1 / d2), float(coarse_ratio), float(fine_ratio)
+    if abs(rc - rf) < 1e-12 * rf:
+        p = math.log(target) / math.log(rf)
+        return p if p > 0 else None
+
+    def ratio(p):  # increasing in p, from ln(rc)/ln(rf) at p -> 0
+        return rf**p * math.expm1(p * math.log(rc)) / math.expm1(p * math.log(rf))
+
+    if target <= math.log(rc) / math.log(rf):
+        return None
+    lo, hi = 1e-9, 1.0
+    while ratio(hi) < target:
+        hi *= 2.0
+        if hi > 200.0:
+            return hi
+    for _ in range(200):  # bisection: ratio() is monotone
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ratio(mid) < target else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def estimate(values, resolutions, tolerance: float = 0.0, sizes=None) -> dict | None:
+    """The converged value of one quantity from its values on meshes `resolutions` (elements
+    along L, increasing; None or nan where a mesh did not give it), with an error bar that holds
+    (the rule of data/fem_gold/README.md, ERROR_BAR_RULE = 2). `sizes` are the meshes' linear
+    resolutions for the refinement ratios (default `resolutions`; the gold passes
+    sqrt(along x across), Celik's N^(1/2), since its fourth mesh refines across by 28/18).
+
+    Of the finest three meshes with a value, d1 = f2 - f1 and d2 = f3 - f2:
+    * asymptotic: d1, d2 of one sign and the observed order p (order_from_ratios) in
+      ASYMPTOTIC_ORDERS: the Richardson extrapolation f3 + d2/(r^p - 1), error bar
+      Fs |d2|/(r^p - 1) (Roache's grid convergence index of the finest mesh), Fs = GCI_SAFETY
+      for p >= LOW_ORDER and GCI_SAFETY_LOW_ORDER below;
+    * otherwise (differences of opposite sign, not shrinking, p outside the window): the finest
+      value, error bar NON_ASYMPTOTIC_FACTOR x max(|d1|, |d2|), and at least the distance
+      |d2|/(r^p - 1) to the limit at the observed order where p < 1, asymptotic False;
+    * two meshes: the finest value, NON_ASYMPTOTIC_FACTOR x their difference; one: no error bar.
+    `tolerance` (the bisection bracket of a threshold) is added to the error bar. None without any
+    value."""
+    sizes = resolutions if sizes is None else sizes
+    triples = [(int(n), float(h), float(v)) for n, h, v in zip(resolutions, sizes, values)
+               if v is not None and np.isfinite(v)]
+    if not triples:
+        return None
+    ns, hs, fs = [t[0] for t in triples], [t[1] for t in triples], [t[2] for t in triples]
     out = {"value": fs[-1], "error_bar": None, "order": None, "asymptotic": False, "finest": fs[-1],
-           "meshes": ns, "basis": "one mesh: no error bar"}
+           "meshes": ns, "basis": "one mesh: no error bar", "rule": ERROR_BAR_RULE}
     if len(fs) == 2:
-        out.update(error_bar=abs(fs[1] - fs[0]) + tolerance, basis="two meshes: the finest value, the spread")
+        out.update(error_bar=NON_ASYMPTOTIC_FACTOR * abs(fs[1] - fs[0]) + tolerance,
+                   basis=f"two meshes: the finest value, {NON_ASYMPTOTIC_FACTOR:g} times their difference")
     if len(fs) >= 3:
-        (n1, n2, n3), (f1, f2, f3) = ns[-3:], fs[-3:]
+        (h1, h2, h3), (f1, f2, f3) = hs[-3:], fs[-3:]
         d1, d2 = f2 - f1, f3 - f2
-        r = n3 / n2
-        shrinking = abs(d2) < abs(d1)
-        p = math.log(abs(d1 / d2)) / math.log(n2 / n1) if d1 * d2 > 0 and shrinking else None
+        r = h3 / h2
+        p = order_from_ratios(d1, d2, h2 / h1, r)
         if p is not None and ASYMPTOTIC_ORDERS[0] <= p <= ASYMPTOTIC_ORDERS[1]:
-            out.update(value=f3 + d2 / (r**p - 1.0), error_bar=GCI_SAFETY * abs(d2) / (r**p - 1.0) + tolerance,
-                       order=p, asymptotic=True, basis="Richardson, observed order, grid convergence index")
+            safety = GCI_SAFETY if p >= LOW_ORDER else GCI_SAFETY_LOW_ORDER
+            out.update(value=f3 + d2 / (r**p - 1.0), error_bar=safety * abs(d2) / (r**p - 1.0) + tolerance,
+                       order=p, asymptotic=True,
+                       basis=f"Richardson, observed order, grid convergence index (safety factor {safety:g})")
         else:
             why = ("differences of one sign, order outside [1, 4]" if p is not None
-                   else "differences change sign" if d1 * d2 <= 0 and shrinking else "differences do not shrink")
-            spread = abs(d2) if shrinking else 3.0 * max(abs(d1), abs(d2))
-            out.update(error_bar=spread + tolerance, order=p, basis=f"not asymptotic ({why}): the finest value")
+                   else "differences change sign" if d1 * d2 <= 0 and abs(d2) < abs(d1)
+                   else "differences do not shrink")
+            spread = NON_ASYMPTOTIC_FACTOR * max(abs(d1), abs(d2))
+            # one sign, shrinking slower than order 1: the limit at the observed order may lie
+            # further than the spread (order 0.5: |d2|/(r^p - 1) = 4.4 |d2|); the bar reaches it
+            reach = abs(d2) / (r**p - 1.0) if p is not None and p < ASYMPTOTIC_ORDERS[0] else 0.0
+            out.update(error_bar=max(spread, reach) + tolerance, order=p,
+                       basis=f"not asymptotic ({why}): the finest value, {NON_ASYMPTOTIC_FACTOR:g} times the "
+                             "largest difference of the finest three meshes"
+                             + (", or the distance to the limit at the observed order" if reach > spread else ""))
     return out
 
 
-def study_estimates(runs, resolutions, band: float = 0.02, default_tolerances: dict | None = None) -> dict:
+def study_estimates(runs, resolutions, band: float = 0.02, default_tolerances: dict | None = None,
+                    sizes=None) -> dict:
     """estimate() of dW1, dW2 (with the runs' bisection tolerances: summary.json's
     threshold_tolerances_over_L, else `default_tolerances` for runs stored before that key), H_mid
     after compression and H_mid(dW) on the common recorded grid of the runs that reached the shear
-    stage; the curve's largest error bar away from the thresholds (|dW - dW_i| > band)."""
+    stage; the curve's largest error bar away from the thresholds (|dW - dW_i| > band). `sizes`:
+    the meshes' linear resolutions for the refinement ratios (estimate; default `resolutions`)."""
     def tolerance(key):
         return max(float((r.summary.get("threshold_tolerances_over_L") or default_tolerances or {}).get(key) or 0.0)
                    for r in runs)
 
-    dw1 = estimate([r.summary["dW1_over_L"] for r in runs], resolutions, 0.5 * tolerance("dW1"))
-    dw2 = estimate([r.summary["dW2_over_L"] for r in runs], resolutions, tolerance("dW2"))
+    sizes = list(resolutions) if sizes is None else list(sizes)
+    dw1 = estimate([r.summary["dW1_over_L"] for r in runs], resolutions, 0.5 * tolerance("dW1"), sizes)
+    dw2 = estimate([r.summary["dW2_over_L"] for r in runs], resolutions, tolerance("dW2"), sizes)
     out = {"dW1": dw1, "dW2": dw2,
-           "H_mid_compressed": estimate([r.summary["H_mid_over_L_compressed"] for r in runs], resolutions)}
-    sheared = [(n, r) for n, r in zip(resolutions, runs) if any(row["stage"] == "shear" for row in r.rows)]
+           "H_mid_compressed": estimate([r.summary["H_mid_over_L_compressed"] for r in runs], resolutions,
+                                        sizes=sizes)}
+    sheared = [(n, h, r) for n, h, r in zip(resolutions, sizes, runs) if any(row["stage"] == "shear" for row in r.rows)]
     if len(sheared) >= 2:
-        resolutions, runs = [n for n, _ in sheared], [r for _, r in sheared]
+        resolutions, sizes, runs = [n for n, _, _ in sheared], [h for _, h, _ in sheared], [r for _, _, r in sheared]
         rows, _ = summarise(runs, resolutions)
         thresholds = [e["value"] if e else None for e in (dw1, dw2)]
-        out["H_mid_curve"], out["H_mid_curve_away"] = _curve_estimates(rows, resolutions, "H_mid_over_L",
+        out["H_mid_curve"], out["H_mid_curve_away"] = _curve_estimates(rows, resolutions, sizes, "H_mid_over_L",
                                                                        thresholds, band)
         if all("F_shear_norm" in row for row in rows):
-            force, away = _curve_estimates(rows, resolutions, "F_shear_norm", thresholds, band)
+            force, away = _curve_estimates(rows, resolutions, sizes, "F_shear_norm", thresholds, band)
             if force:
                 out["F_shear_curve"], out["F_shear_curve_away"] = force, away
     return out
 
 
-def _curve_estimates(rows, resolutions, column: str, thresholds, band: float) -> tuple[list[dict], dict]:
-    """estimate() of `column` (summarise's rows) at every dW of the common grid, and the figures of
-    its points more than `band` from the thresholds (points, asymptotic points, largest error bar)."""
+def _curve_estimates(rows, resolutions, sizes, column: str, thresholds, band: float) -> tuple[list[dict], dict]:
+    """estimate() of `column` (summarise's rows) at every dW of the grid, from the meshes that
+    reached it, and the figures of its points more than `band` from the thresholds (points,
+    asymptotic points, largest error bar). A point that only one mesh reached has no error bar
+    and is left out: the curve ends where fewer than two meshes go on."""
     values = {(row["resolution"], row["dW_over_L"]): row[column] for row in rows}
     curve = []
     for x in sorted({row["dW_over_L"] for row in rows}):
-        e = estimate([values[(n, x)] for n in resolutions], resolutions)
-        if e is None:   # no mesh recorded it there (nan)
+        e = estimate([values[(n, x)] for n in resolutions], resolutions, sizes=sizes)
+        if e is None or e["error_bar"] is None:   # fewer than two meshes recorded it there (nan)
             continue
         curve.append({"dW_over_L": x, **{k: e[k] for k in ("value", "error_bar", "order", "asymptotic")}})
     away = [c for c in curve if _away(np.array([c["dW_over_L"]]), *thresholds, margin=band)[0]]
@@ -255,8 +325,9 @@ def table_from_runs(args) -> int:
 
 
 def summarise(runs, resolutions):
-    """Per-mesh H_mid(dW) on the coarsest run's recorded dW grid (each run interpolated onto it,
-    up to the smallest dW all runs reached), extrapolated values and estimated errors."""
+    """Per-mesh H_mid(dW) on the recorded dW grid of the coarsest of the runs that went furthest
+    (each run interpolated onto it, nan beyond the largest dW it reached: a run that stopped short
+    leaves the others' points in place), extrapolated values and estimated errors."""
     shear = [[r for r in run.rows if r["stage"] == "shear"] for run in runs]
     curves, forces = [], []
     for s in shear:
@@ -265,17 +336,26 @@ def summarise(runs, resolutions):
         curves.append((dw_i[order], np.array([row["H_mid_over_L"] for row in s])[order]))
         force = [row.get("F_shear_norm") for row in s]
         forces.append(None if any(f is None or f == "" for f in force) else np.array(force, float)[order])
-    reach = min(c[0][-1] for c in curves)
-    grid = [row for row in shear[0] if row["dW_over_L"] <= reach + 1e-12]
+    reach = [c[0][-1] for c in curves]
+    furthest = next(i for i, x in enumerate(reach) if x >= max(reach) - 1e-12)
+    grid = shear[furthest]
     n_common = len(grid)
     dw = np.array([row["dW_over_L"] for row in grid])
-    H = np.array([np.interp(dw, *c) for c in curves])
+
+    def on_grid(x, y, end):
+        return np.where(dw <= end + 1e-12, np.interp(dw, x, y), np.nan)
+
+    H = np.array([on_grid(*c, end) for c, end in zip(curves, reach)])
     # the clamp's shear force on the same grid (paper Fig. E.18), where every run recorded it
-    F = None if any(f is None for f in forces) else np.array([np.interp(dw, c[0], f) for c, f in zip(curves, forces)])
-    def phase_nearest(rows, x):
+    F = None if any(f is None for f in forces) else \
+        np.array([on_grid(c[0], f, end) for c, f, end in zip(curves, forces, reach)])
+
+    def phase_nearest(rows, x, end):
+        if x > end + 1e-12:
+            return ""
         return rows[int(np.argmin(np.abs(np.array([r["dW_over_L"] for r in rows]) - x)))]["phase"]
 
-    phases = [[phase_nearest(s, x) for x in dw] for s in shear]
+    phases = [[phase_nearest(s, x, end) for x in dw] for s, end in zip(shear, reach)]
     compressed = np.array([[run.summary["H_mid_over_L_compressed"]] for run in runs])
     H_ext, p = extrapolate(H, resolutions) if len(runs) >= 2 else (H[-1], np.full(n_common, np.nan))
     Hc_ext, pc = extrapolate(compressed, resolutions) if len(runs) >= 2 else (compressed[-1], [np.nan])
@@ -340,7 +420,8 @@ def write_outputs(out: Path, rows, table, runs, resolutions, strip, protocol) ->
     lines = [f"# FEM mesh convergence: W/L = {strip.width_ratio:.4g}, dL/L = {protocol.compression_ratio:g}, "
              f"L/b = {strip.slenderness:.0f}", "",
              "Richardson extrapolation from the finest meshes with the observed order (clipped to [0.5, 4]); "
-             "errors are |value - extrapolated|. H errors over the common recorded dW grid; 'away' excludes "
+             "errors are |value - extrapolated|. H errors over the recorded dW grid, each mesh up to where it "
+             "reached; 'away' excludes "
              "dW within 0.02 L of dW1 and dW2.", "",
              "| N along L | triangles | unknowns | H_mid/L compressed | error | dW1/L | error | dW2/L | error | "
              "dW/L reached | max H error | max H error away | s / step | s / path | Newton its |",

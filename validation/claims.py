@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ddg.analysis.analytic import clamped_elastica_midpoint_height
+from ddg.geometry.strip import shear_limit
 
 from .reference import curve_error, paper_value
 
@@ -23,9 +24,13 @@ from .reference import curve_error, paper_value
 @dataclass(frozen=True)
 class Claim:
     """A stated agreement. Single-model claims compare |measured| with `bound`. A cross-model
-    claim (error_bar_limit set) compares two converged values (validation.estimates): it holds when
-    their difference exceeds their combined error bar by at most `bound`, and that combined error
-    bar is itself at most `error_bar_limit` (wider error bars cannot decide the claim)."""
+    claim (error_bar_limit set) compares two converged values (validation.estimates) at every
+    compared point or scene (issue 28): it holds where |difference| <= bound and the combined
+    error bar <= error_bar_limit; it fails where the difference exceeds the bound with error bars
+    that can decide it (combined <= limit), or exceeds the bound even beyond the combined error bar,
+    or where a curve's reference stops short of the compared range; elsewhere it is undecided
+    (error bars too wide to tell). The claim's outcome is the worst of its points: fails, else
+    undecided, else holds."""
     key: str
     statement: str
     bound: float
@@ -34,6 +39,16 @@ class Claim:
     @property
     def cross_model(self) -> bool:
         return self.error_bar_limit is not None
+
+    def outcome_at(self, difference: float, combined_error_bar: float) -> str:
+        """"holds", "fails" or "undecided" at one compared point (see the class docstring)."""
+        if combined_error_bar <= self.error_bar_limit:
+            return "holds" if difference <= self.bound else "fails"
+        return "fails" if difference - combined_error_bar > self.bound else "undecided"
+
+
+#: Outcomes of a claim, best first: the worst of a claim's points is its outcome.
+OUTCOMES = ("holds", "undecided", "fails")
 
 
 CLAIMS = {c.key: c for c in (
@@ -50,32 +65,33 @@ CLAIMS = {c.key: c for c in (
           "relative error", 3e-4),
     # Cross-model claims: converged values (validation.estimates) with their error bars; bounds from
     # issue 5 (H_mid 0.01 L away from the thresholds, dW1 0.02 L), the same as the combined error bar
-    # that can decide them. The excluded band (0.02 L about each threshold) as in issue 5.
+    # that can decide them. The excluded band (0.02 L about each threshold) as in issue 5. Since
+    # issue 28 the bound is on the difference itself (Claim.outcome_at), not on its excess beyond the
+    # combined error bar, and a curve is compared over the whole shear range.
     Claim("rod_vs_plate_narrow_U", "rod vs plate studies at W/L = 1/20, dL/L = 1/2: largest H_mid difference/L "
-          "beyond the combined error bar on the U branch (dW up to 0.02 below the first dW1)", 0.01, 0.01),
-    Claim("plate_vs_fem_curve", "plate vs FEM studies at W/L = 1/6, dL/L = 1/2: largest H_mid difference/L beyond "
-          "the combined error bar over the shear, 0.02 away from either model's thresholds", 0.01, 0.01),
-    Claim("plate_vs_fem_dW1", "plate vs FEM studies at W/L = 1/6, dL/L = 1/2: dW1 difference/L beyond the combined "
-          "error bar", 0.02, 0.02),
+          "on the U branch (dW up to 0.02 below the first dW1)", 0.01, 0.01),
+    Claim("plate_vs_fem_curve", "plate vs FEM studies at W/L = 1/6, dL/L = 1/2: largest H_mid difference/L "
+          "over the whole shear range, 0.02 away from either model's thresholds", 0.01, 0.01),
+    Claim("plate_vs_fem_dW1", "plate vs FEM studies at W/L = 1/6, dL/L = 1/2: dW1 difference/L", 0.02, 0.02),
     Claim("plate_vs_fem_narrow_thresholds", "plate vs FEM studies at W/L = 1/20 and 1/12, dL/L = 1/2 and 1/4: "
-          "largest dW1, dW2 difference/L beyond the combined error bar", 0.02, 0.02),
+          "largest dW1, dW2 difference/L", 0.02, 0.02),
     Claim("plate_vs_fem_narrow_curve", "plate vs FEM studies at W/L = 1/20 and 1/12, dL/L = 1/2 and 1/4: largest "
-          "H_mid difference/L beyond the combined error bar, 0.02 away from the thresholds", 0.01, 0.01),
+          "H_mid difference/L over the whole shear range, 0.02 away from the thresholds", 0.01, 0.01),
     Claim("plate_vs_fem_own_material_curve", "plate study vs the FEM shell with the plate's material "
           "(data/fem_dep, 90 elements; its error bar that of the nu = 0 shell on the same mesh, data/fem_fine) "
-          "at W/L = 1/6, dL/L = 1/2: largest H_mid difference/L beyond the combined error bar, 0.02 away from the "
-          "thresholds", 0.01, 0.01),
+          "at W/L = 1/6, dL/L = 1/2: largest H_mid difference/L over the whole shear range, 0.02 away from "
+          "the thresholds", 0.01, 0.01),
     # The clamp's shear force (paper Fig. E.18), F_shear L/(E b^3), compared as the H_mid curves are (same
     # studies, same scenes, same excluded band) but relative to the force's scale on the scene (the FEM's
     # largest |F| on the compared points): the H_mid bound 0.01 L is 2.6 % / 3.3 % of H_mid's scale (the
     # compressed height, 0.38 L / 0.30 L at dL/L = 1/2 / 1/4), so 0.03 of the force's scale, the same for
     # the combined error bar that can decide it. Fixed before the force studies were computed.
     Claim("plate_vs_fem_force", "plate vs FEM studies at W/L = 1/6, 1/12 and 1/20 (dL/L = 1/2; 1/12 and 1/20 also "
-          "at 1/4): largest shear-force difference beyond the combined error bar, relative to the FEM's largest "
+          "at 1/4): largest shear-force difference over the whole shear range, relative to the FEM's largest "
           "|F_shear| on the scene, 0.02 away from either model's thresholds", 0.03, 0.03),
     Claim("plate_vs_fem_own_material_force", "plate study vs the FEM shell with the plate's material (data/fem_dep, "
           "90 elements; its error bar that of the nu = 0 shell on the same mesh) at W/L = 1/6, dL/L = 1/2: largest "
-          "shear-force difference beyond the combined error bar, relative to the FEM's largest |F_shear|, 0.02 away "
+          "shear-force difference over the whole shear range, relative to the FEM's largest |F_shear|, 0.02 away "
           "from the thresholds", 0.03, 0.03),
     Claim("rod_thresholds_paper", "rod at W/L = 1/20 (dL/L = 1/2 and 1/4): largest difference of dW1, dW2 from the "
           "paper, /L", 0.02),
@@ -129,6 +145,8 @@ def paper_threshold_error(run) -> float | None:
 NARROW_SCENES = ((0.5, 1 / 20), (0.5, 1 / 12), (0.25, 1 / 20), (0.25, 1 / 12))
 #: dW closer than this to a threshold is left out of a curve comparison (issue 5).
 THRESHOLD_BAND = 0.02
+#: A curve that reaches within this of dW_max/L reaches it (the recorded end of a complete path).
+REACH_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -136,7 +154,10 @@ class Agreement:
     """Two converged values compared: the largest difference, the combined error bar (the sum of
     the two: discretisation error bars are bounds, not independent deviations), and the excess of
     the difference over the combined error bar (0 where they agree within it), each the worst over
-    the points or scenes compared; `where` names the worst one."""
+    the points or scenes compared; `where` names the point of the largest difference. `pairs`
+    keeps (difference, combined error bar, where) of every compared point, for the claim's
+    pointwise outcome (Claim.outcome_at); `short` says where a curve's reference (or the compared
+    model) stops short of the compared range, which fails a claim."""
     difference: float
     combined_error_bar: float
     excess: float
@@ -144,20 +165,35 @@ class Agreement:
     where: str = ""
     at: float | None = None       # a curve's worst dW/L
     scale: float = 1.0            # what the figures are relative to (a force curve: the reference's largest |F|)
+    pairs: tuple = ()
+    short: str = ""
 
     @property
     def in_error_bars(self) -> float:
         """The difference in units of the combined error bar."""
         return self.difference / self.combined_error_bar if self.combined_error_bar > 0 else float("inf")
 
+    def deciding(self, claim: Claim) -> tuple[str, tuple]:
+        """The claim's outcome over the compared points, and the point that decides it (the
+        largest difference among the points of that outcome)."""
+        if not self.pairs:
+            return "holds", (self.difference, self.combined_error_bar, self.where)
+        outcomes = [claim.outcome_at(d, c) for d, c, _ in self.pairs]
+        outcome = max(outcomes, key=OUTCOMES.index)
+        worst = max((p for p, o in zip(self.pairs, outcomes) if o == outcome), key=lambda p: p[0])
+        return outcome, worst
+
     @classmethod
     def worst(cls, agreements: list[Agreement]) -> Agreement | None:
-        """The combination over several scenes: the largest of each figure (None if any is None)."""
+        """The combination over several scenes: the largest of each figure, every point (None if
+        any is None)."""
         if not agreements or any(a is None for a in agreements):
             return None
-        worst = max(agreements, key=lambda a: (a.excess, a.combined_error_bar))
-        return cls(max(a.difference for a in agreements), max(a.combined_error_bar for a in agreements),
-                   worst.excess, sum(a.points for a in agreements), worst.where)
+        largest = max(agreements, key=lambda a: a.difference)
+        return cls(largest.difference, max(a.combined_error_bar for a in agreements),
+                   max(a.excess for a in agreements), sum(a.points for a in agreements), largest.where,
+                   pairs=tuple(p for a in agreements for p in a.pairs),
+                   short="; ".join(a.short for a in agreements if a.short))
 
 
 def threshold_agreement(a, b, key: str = "dW1") -> Agreement | None:
@@ -167,26 +203,37 @@ def threshold_agreement(a, b, key: str = "dW1") -> Agreement | None:
     if ea is None or eb is None or ea.error_bar is None or eb.error_bar is None:
         return None
     diff, combined = abs(ea.value - eb.value), ea.error_bar + eb.error_bar
-    return Agreement(diff, combined, max(diff - combined, 0.0), 1, _scene(a) + f" {key}")
+    where = _scene(a) + f" {key}"
+    return Agreement(diff, combined, max(diff - combined, 0.0), 1, where, pairs=((diff, combined, where),))
 
 
 def curve_agreement(a, b, band: float = THRESHOLD_BAND, upto: float | None = None,
-                    quantity: str = "H_mid") -> Agreement | None:
+                    quantity: str = "H_mid", start: float = 0.0) -> Agreement | None:
     """Studies a and b on a curve against dW/L ("H_mid": their H_mid(dW) curves, in units of L;
     "force": their clamp-force curves relative to the scale of b's, the largest |F| of b on the
-    compared points), pointwise on a's grid inside b's range, `band` away from both studies'
-    thresholds and at most `upto`; None without a common point."""
+    compared points), pointwise on a's grid over the whole range from `start` to `upto` (default:
+    the scene's dW_max, the end of the shear), `band` away from both studies' thresholds; where b
+    (the reference) or a stops short of that range the Agreement's `short` says so (the claim
+    fails there). None without a common point."""
     from .estimates import away_from
 
     ca, cb = (a.curve, b.curve) if quantity == "H_mid" else (a.force, b.force)
     if ca is None or cb is None:
         return None
+    end = upto if upto is not None else dw_max_over_L(a)
     dw = ca.dw
-    keep = (dw >= cb.dw[0]) & (dw <= cb.dw[-1]) & away_from(dw, a.thresholds() + b.thresholds(), band)
-    if upto is not None:
-        keep &= dw <= upto
+    wanted = away_from(dw, a.thresholds() + b.thresholds(), band) & (dw >= start - REACH_TOLERANCE) & \
+        (dw <= end + REACH_TOLERANCE)
+    keep = wanted & (dw >= cb.dw[0] - REACH_TOLERANCE) & (dw <= cb.dw[-1] + REACH_TOLERANCE)
     if not np.any(keep):
         return None
+    short = []
+    missing = int(np.sum(wanted & ~keep))
+    if missing:
+        short.append(f"the reference's {quantity} curve of {_scene(b)} ends at dW/L = {cb.dw[-1]:.3f} of "
+                     f"{end:.3f} ({missing} compared points beyond it)")
+    if ca.dw[-1] < end - REACH_TOLERANCE:
+        short.append(f"the compared {quantity} curve of {_scene(a)} ends at dW/L = {ca.dw[-1]:.3f} of {end:.3f}")
     vb, eb = cb.at(dw[keep])
     scale = 1.0 if quantity == "H_mid" else float(np.max(np.abs(vb)))
     if not scale > 0:
@@ -194,10 +241,17 @@ def curve_agreement(a, b, band: float = THRESHOLD_BAND, upto: float | None = Non
     diff = np.abs(ca.value[keep] - vb) / scale
     combined = (ca.error_bar[keep] + eb) / scale
     excess = diff - combined
-    k = int(np.argmax(excess))
-    where = f"{_scene(a)} dW/L = {dw[keep][k]:.4f}" + ("" if quantity == "H_mid" else f", max |F| {scale:.4g}")
-    return Agreement(float(diff.max()), float(combined.max()), float(max(excess[k], 0.0)), int(keep.sum()), where,
-                     float(dw[keep][k]), scale)
+    k = int(np.argmax(diff))
+    suffix = "" if quantity == "H_mid" else f", max |F| {scale:.4g}"
+    labels = [f"{_scene(a)} dW/L = {x:.4f}{suffix}" for x in dw[keep]]
+    return Agreement(float(diff.max()), float(combined.max()), float(max(excess.max(), 0.0)), int(keep.sum()),
+                     labels[k], float(dw[keep][k]), scale,
+                     pairs=tuple(zip(diff.tolist(), combined.tolist(), labels)), short="; ".join(short))
+
+
+def dw_max_over_L(study) -> float:
+    """The scene's shear limit dW_max/L (paper Eq. B.1), the end of every shear path."""
+    return float(shear_limit(1.0, study.width_ratio, study.compression_ratio))
 
 
 def u_branch_agreement(a, b, band: float = THRESHOLD_BAND) -> Agreement | None:
@@ -226,33 +280,46 @@ def resolution_needed(study, key: str, accuracy: float) -> str:
 
 
 def evaluate(key: str, measured, missing: str = "", needs: str = "") -> dict:
-    """The verdict on one claim. Single-model claims: measured |value| against its bound. Cross-model
-    claims: measured an Agreement, holding when its excess is within the bound and its combined error
-    bar within the claim's error_bar_limit. A claim without a finite measured value does not hold
-    (holds False, reason "no data: ..."): the report cannot claim an agreement it did not measure.
+    """The verdict on one claim: `outcome` "holds", "fails" or "undecided" and `holds` (outcome ==
+    "holds"). Single-model claims: measured |value| against its bound. Cross-model claims: measured
+    an Agreement, its outcome the worst of its points (Claim.outcome_at: |difference| <= bound and
+    combined error bar <= the claim's error_bar_limit holds; a difference beyond the bound that the
+    error bars can decide, or beyond bound + combined error bar, fails; else undecided), failing
+    where a curve's reference stops short of the compared range. A claim without a finite measured
+    value fails (reason "no data: ..."): the report cannot claim an agreement it did not measure.
     `missing` says what was missing (the runs or reference data); `needs`, the resolution each model
     needs for the claim (resolution_needed)."""
     claim = CLAIMS[key]
     out = {"claim": key, "statement": claim.statement, "bound": claim.bound, "measured": None, "holds": False,
-           "reason": "", "difference": None, "combined_error_bar": None, "in_error_bars": None, "needs": needs}
+           "outcome": "fails", "reason": "", "difference": None, "combined_error_bar": None,
+           "in_error_bars": None, "needs": needs}
     if isinstance(measured, Agreement):
-        out.update(measured=measured.excess, difference=measured.difference,
-                   combined_error_bar=measured.combined_error_bar, in_error_bars=measured.in_error_bars)
-        decidable = measured.combined_error_bar <= claim.error_bar_limit
-        within = measured.excess <= claim.bound
-        out["holds"] = bool(decidable and within)
-        out["reason"] = (f"difference {measured.difference:.4g}, combined error bar {measured.combined_error_bar:.4g} "
-                         f"({'<=' if decidable else '>'} {claim.error_bar_limit:g}), excess {measured.excess:.4g} "
-                         f"{'<=' if within else '>'} bound {claim.bound:g}"
-                         + (f"; worst at {measured.where}" if measured.where else ""))
+        outcome, (diff, combined, where) = measured.deciding(claim)
+        if measured.short:
+            outcome = "fails"
+        out.update(measured=measured.difference, difference=measured.difference,
+                   combined_error_bar=measured.combined_error_bar, in_error_bars=measured.in_error_bars,
+                   outcome=outcome, holds=outcome == "holds")
+        decidable = combined <= claim.error_bar_limit
+        within = diff <= claim.bound
+        point = (f"difference {diff:.4g} ({'<=' if within else '>'} bound {claim.bound:g}), combined error bar "
+                 f"{combined:.4g} ({'<=' if decidable else '>'} {claim.error_bar_limit:g})"
+                 + (f" at {where}" if where else ""))
+        worst = (f"; largest difference {measured.difference:.4g}, largest combined error bar "
+                 f"{measured.combined_error_bar:.4g} over {measured.points} compared point(s)")
+        if measured.short:
+            out["reason"] = f"fails: {measured.short}; {point}{worst}"
+        else:
+            out["reason"] = f"{outcome}: {point}{worst}"
         return out
     value = None if measured is None or not np.isfinite(measured) else abs(float(measured))
     if value is None:
         what = missing or ("no finite measured value" if measured is not None else "no measured value")
         out["reason"] = f"no data: {what}"
     else:
-        out.update(measured=value, holds=bool(value <= claim.bound))
-        out["reason"] = f"measured {value:.4g} {'<=' if out['holds'] else '>'} bound {claim.bound:g}"
+        holds = bool(value <= claim.bound)
+        out.update(measured=value, holds=holds, outcome="holds" if holds else "fails")
+        out["reason"] = f"measured {value:.4g} {'<=' if holds else '>'} bound {claim.bound:g}"
     return out
 
 

@@ -28,8 +28,8 @@ from .verdicts import (PAPER_DISAGREEMENT, ClaimsVerdict, MaterialCheck, MeshTre
                        unusual_outcomes)
 
 MODELS = ("rod", "plate", "ribbon") + WIDE_RIBBONS
-CLAIM_COLUMNS = ["claim", "statement", "bound", "measured", "holds", "reason", "difference", "combined_error_bar",
-                 "in_error_bars", "needs"]
+CLAIM_COLUMNS = ["claim", "statement", "bound", "measured", "holds", "outcome", "reason", "difference",
+                 "combined_error_bar", "in_error_bars", "needs"]
 THRESHOLD_COLUMNS = ["model", "compression_ratio", "width_ratio", "dW1_over_L", "paper_dW1", "dW1_rel_diff_vs_paper",
                      "dW2_over_L", "paper_dW2", "dW2_rel_diff_vs_paper", "dW2_S_stable_over_L",
                      "dW1_drop_vs_W_1_20_percent", "paper_drop_percent", "dW_max_over_L", "resolved_up_to_dW_over_L"]

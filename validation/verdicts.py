@@ -143,7 +143,16 @@ class ClaimsVerdict:
 
     @property
     def failing(self) -> list[dict]:
+        """The claims that do not hold: they fail or are undecided."""
         return [c for c in self.claims if not c["holds"]]
+
+    @property
+    def failed(self) -> list[dict]:
+        return [c for c in self.claims if c.get("outcome", "holds" if c["holds"] else "fails") == "fails"]
+
+    @property
+    def undecided(self) -> list[dict]:
+        return [c for c in self.claims if c.get("outcome") == "undecided"]
 
     @property
     def all_hold(self) -> bool:

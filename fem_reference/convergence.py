@@ -65,6 +65,10 @@ GCI_SAFETY_LOW_ORDER = 3.0
 #: its finest three meshes as its error bar (issue 28: at W/L = 1/6, dL/L = 1/2 the gold's 0.0010
 #: from |d2| alone was 3.5 times smaller than the distance to an independent mesh series).
 NON_ASYMPTOTIC_FACTOR = 3.0
+#: The slowest order the rule extrapolates at: a sequence shrinking slower has not begun to
+#: converge (at order 0.1 its limit would lie 24 |d2| away, at 0 infinitely far); its distance to
+#: the limit is taken at this order.
+SLOWEST_ORDER = 0.5
 #: The rule's version, stored with every estimate (richardson.json "rule"): 1 the spread of the
 #: finest two and GCI 1.25 at any order (before issue 28), 2 the rule above.
 ERROR_BAR_RULE = 2
@@ -117,7 +121,8 @@ def estimate(values, resolutions, tolerance: float = 0.0, sizes=None) -> dict | 
       for p >= LOW_ORDER and GCI_SAFETY_LOW_ORDER below;
     * otherwise (differences of opposite sign, not shrinking, p outside the window): the finest
       value, error bar NON_ASYMPTOTIC_FACTOR x max(|d1|, |d2|), and at least the distance
-      |d2|/(r^p - 1) to the limit at the observed order where p < 1, asymptotic False;
+      |d2|/(r^p - 1) to the limit at the observed order where p < 1 and both differences exceed
+      the bisection bracket (p counted as at least SLOWEST_ORDER), asymptotic False;
     * two meshes: the finest value, NON_ASYMPTOTIC_FACTOR x their difference; one: no error bar.
     `tolerance` (the bisection bracket of a threshold) is added to the error bar. None without any
     value."""
@@ -147,9 +152,12 @@ def estimate(values, resolutions, tolerance: float = 0.0, sizes=None) -> dict | 
                    else "differences change sign" if d1 * d2 <= 0 and abs(d2) < abs(d1)
                    else "differences do not shrink")
             spread = NON_ASYMPTOTIC_FACTOR * max(abs(d1), abs(d2))
-            # one sign, shrinking slower than order 1: the limit at the observed order may lie
-            # further than the spread (order 0.5: |d2|/(r^p - 1) = 4.4 |d2|); the bar reaches it
-            reach = abs(d2) / (r**p - 1.0) if p is not None and p < ASYMPTOTIC_ORDERS[0] else 0.0
+            # one sign, shrinking slower than order 1, differences resolved (beyond the bisection
+            # bracket): the limit at the observed order may lie further than the spread (order 0.5:
+            # |d2|/(r^p - 1) = 4.4 |d2|); the bar reaches it, orders below SLOWEST_ORDER counted as it
+            resolved = min(abs(d1), abs(d2)) > tolerance
+            slow = p is not None and p < ASYMPTOTIC_ORDERS[0] and resolved
+            reach = abs(d2) / (r**max(p, SLOWEST_ORDER) - 1.0) if slow else 0.0
             out.update(error_bar=max(spread, reach) + tolerance, order=p,
                        basis=f"not asymptotic ({why}): the finest value, {NON_ASYMPTOTIC_FACTOR:g} times the "
                              "largest difference of the finest three meshes"

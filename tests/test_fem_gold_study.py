@@ -60,6 +60,16 @@ def test_differences_that_grow_give_three_times_the_largest():
     assert e["error_bar"] == pytest.approx(3 * 0.008)
 
 
+def test_a_sequence_that_has_not_begun_to_converge_gets_a_finite_bar():
+    """Differences within the bisection bracket (the rod's dW2 at M = 50/100/200, bracket 1e-3 L)
+    or an order near 0: no extrapolation to an infinitely far limit, 3 x the largest difference,
+    or the distance at order 0.5."""
+    noise = estimate([0.5230, 0.5238, 0.52459], MESHES, 1e-3)
+    assert noise["error_bar"] == pytest.approx(3 * 0.0008 + 1e-3)
+    stalled = estimate([0.30, 0.31, 0.3199], MESHES)
+    assert stalled["error_bar"] == pytest.approx(0.0099 / (1.5**0.5 - 1))
+
+
 @pytest.mark.parametrize("order", [0.5, 0.75, 5.0])
 def test_an_order_outside_the_window_is_not_asymptotic(order):
     """Shrinking, one sign, but p outside [1, 4]: the finest value, 3 x the largest difference

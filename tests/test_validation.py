@@ -81,7 +81,7 @@ def test_smoke_report_evaluates_the_claims_its_runs_allow_and_fails_the_others(s
     assert sorted(summary["claims_failing"]) == failing
     report = (out / "report.md").read_text()
     assert f"{len(failing)} of {len(claims)} claims do not hold" in report
-    assert "rod_elastica (no data: no rod run (M = 100, W/L = 1/20, dL/L = 1/2))" in report
+    assert "rod_elastica (fails: no data: no rod run (M = 100, W/L = 1/20, dL/L = 1/2))" in report
 
 
 def test_rerun_takes_every_run_from_the_cache(smoke_report, monkeypatch):
@@ -215,8 +215,12 @@ def test_claims_sentence_names_every_claim_that_does_not_hold():
     assert claims_sentence(good) == "All 2 claims hold: each measured value is at or below its bound."
     bad = good + [C.evaluate("fem_elastica", 1.0), C.evaluate("plate_elastica", None, "no plate run")]
     text = claims_sentence(bad)
-    assert text.startswith("**2 of 4 claims do not hold: ") and "All" not in text
-    assert "fem_elastica (measured 1 > bound 0.0003)" in text and "plate_elastica (no data: no plate run)" in text
+    assert text.startswith("**2 of 4 claims do not hold (2 fail, 0 undecided): ") and "All" not in text
+    assert "fem_elastica (fails: measured 1 > bound 0.0003)" in text
+    assert "plate_elastica (fails: no data: no plate run)" in text
+    undecided = C.evaluate("plate_vs_fem_dW1", C.Agreement(0.005, 0.03, 0.0, pairs=((0.005, 0.03, "here"),)))
+    text = claims_sentence(good + [undecided])
+    assert text.startswith("**1 of 3 claims do not hold (0 fail, 1 undecided): plate_vs_fem_dW1 (undecided: ")
 
 
 def test_stability_map_outcome_follows_each_run_summary():
@@ -362,7 +366,8 @@ def test_a_failing_claim_renders_as_failing():
     bound = C.CLAIMS["fem_elastica"].bound
     failing = _hand_made_report([C.evaluate("rod_elastica", 2e-4), C.evaluate("fem_elastica", 1.01 * bound)])
     md, page = render_markdown(failing), render_html(failing)
-    assert f"**1 of 2 claims do not hold: fem_elastica (measured {1.01 * bound:.4g} > bound {bound:g}).**" in md
+    assert (f"**1 of 2 claims do not hold (1 fail, 0 undecided): fem_elastica (fails: measured {1.01 * bound:.4g} > "
+            f"bound {bound:g}).**") in md
     assert "All 2 claims hold" not in md and "All 2 claims hold" not in page
     fem_row = next(line for line in md.splitlines() if line.startswith("| fem_elastica |"))
     assert "| False |" in fem_row

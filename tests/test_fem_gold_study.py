@@ -219,3 +219,30 @@ def test_the_error_map_scenes_are_named_by_their_strip_and_run_only_when_asked()
         chosen = check_gold_inputs(SimpleNamespace(only=["dL0.5_W0.05_Lb300"], levels=None, resolution=None,
                                                    out=out))
         assert [(s[0], s[3]) for s in chosen] == [("dL0.5_W0.05_Lb300", 300.0)]
+
+
+def test_independent_series_are_estimated_and_compared(tmp_path):
+    """fem_reference.series: each mesh series of W/L = 1/6, dL/L = 1/2 estimated with the gold's
+    rule; two series converging at order 2 to limits 0.005 apart, each with a tiny error bar,
+    disagree, and each candidate value is placed inside or outside each series' error bar."""
+    from fem_reference import series
+
+    data = tmp_path
+    gold = [(64, 8), (96, 12), (144, 18), (216, 28)]
+    iso = [(96, 16), (144, 24), (216, 36)]
+    for (along, across), limit in [(m, 0.2650) for m in gold] + [(m, 0.2700) for m in iso]:
+        h = (along * across) ** -0.5
+        _stored_run(data / "fem_gold" / "dL0.5_W0.1667" / f"N{along}x{across}", along, across,
+                    limit - 1.0 * h**2, 0.43, [0.37, 0.36, 0.35])
+    out = series.write_series(data / "fem_gold" / "dL0.5_W0.1667")
+    by_name = {s["name"]: s for s in out["series"]}
+    assert by_name["gold"]["dW1"]["value"] == pytest.approx(0.2650, abs=1e-9)
+    assert by_name["isotropic"]["dW1"]["value"] == pytest.approx(0.2700, abs=1e-9)
+    assert by_name["older isotropic"]["runs"] == []
+    pair = next(c for c in out["checks"]
+                if c.get("a") == "gold" and c.get("b") == "isotropic" and c["quantity"] == "dW1")
+    assert not pair["agree"] and pair["difference"] == pytest.approx(0.005, abs=1e-9)
+    placed = {c["candidate"]: c for c in out["checks"] if "candidate" in c}
+    assert placed[0.2646]["inside"] == [] and set(placed[0.2685]["outside"]) == {"gold", "isotropic"}
+    assert (data / "fem_gold" / "dL0.5_W0.1667" / "series.md").exists()
+    assert series.write_series(data / "fem_gold" / "dL0.5_W0.05") is None

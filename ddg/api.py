@@ -158,13 +158,16 @@ def _open_folder(out, summary: dict):
     return RunFolder(out, summary)
 
 
-def _recorders(model, folder, progress_bar, writer=None, compression_ratio: float = 0.0):
-    """Listeners every model's run has: path.csv row by row, the centerline per row, frames,
-    progress; returns (listeners, centerlines)."""
+def _recorders(model, folder, progress_bar, writer=None, compression_ratio: float = 0.0, centerline: bool = True):
+    """Listeners every model's run has: path.csv row by row, the centerline per row (unless
+    centerline=False: then no centerline.csv either), frames, progress; returns (listeners, centerlines)."""
     centerlines: list[np.ndarray] = []
+    recorded = [0]   # rows so far: the frame number
 
     def keep_centerline(stage, state, row):
-        centerlines.append(model.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
+        recorded[0] += 1
+        if centerline:
+            centerlines.append(model.centerline_positions(state.q, CENTERLINE_STATIONS)[0])
 
     listeners = []
     if folder is not None:
@@ -177,7 +180,7 @@ def _recorders(model, folder, progress_bar, writer=None, compression_ratio: floa
             points, cells = frame_content(model, state.q)
             # ParaView's time: dW/L on the shear, dL/L - dL_end/L (<= 0) on the compression
             time = row["dW_over_L"] if stage == "shear" else row["dL_over_L"] - compression_ratio
-            writer.write(points, step=len(centerlines) - 1, dL_over_L=row["dL_over_L"], dW_over_L=row["dW_over_L"],
+            writer.write(points, step=recorded[0] - 1, dL_over_L=row["dL_over_L"], dW_over_L=row["dW_over_L"],
                          stage=stage, cell_data=cells, time=time)
 
         listeners.append(write_frame)
@@ -223,6 +226,7 @@ def simulate(
     quantities=None,
     error_map=None,
     zeta: float | None = None,
+    centerline: bool = True,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
@@ -254,6 +258,8 @@ def simulate(
     "ribbon-wunderlich"'s ruling slope (default the Sano-Wada value sqrt((1 - nu) / 60) W^2 / b);
     summary keys zeta, zeta_over_L. The ribbons with width ("ribbon-sano-wada", "ribbon-trapeze",
     "ribbon-wunderlich", ddg.models.wide_ribbons) run like the rod (resolution = nodes M).
+    centerline=False records no centerline (result.centerlines empty, no out/centerline.csv): for
+    studies that read only path.csv and summary.json (the gold and mesh studies in data/).
     model="auto" with `tolerance` (units of L; `quantities` of dW1, dW2, H_mid, default all;
     `error_map` a CSV, default $DDG_ERROR_MAP or data/error_map/error_map.csv): the cheapest
     model and resolution the error map predicts within the tolerance on this scene, or the safe
@@ -263,7 +269,8 @@ def simulate(
     if isinstance(model, str) and model == "auto":
         return simulate_auto(strip, protocol, tolerance, quantities, error_map, resolution=resolution, out=out,
                              options=options, progress=progress, solver=solver, dynamic_options=dynamic_options,
-                             mesh=mesh, frames=frames, thresholds=thresholds, branches=branches, probe=probe)
+                             mesh=mesh, frames=frames, thresholds=thresholds, branches=branches, probe=probe,
+                             centerline=centerline)
     if tolerance is not None or quantities is not None or error_map is not None:
         raise InputError(f"tolerance = {tolerance!r} (and quantities, error_map) apply to model='auto' only, "
                          f"not model = {model!r}")
@@ -272,7 +279,7 @@ def simulate(
     check_model_name(model)
     if options is not None and not isinstance(options, ContinuationOptions):
         raise InputError(f"options = {options!r} must be a ddg.ContinuationOptions")
-    _checked_flags(progress=progress, frames=frames, thresholds=thresholds)
+    _checked_flags(progress=progress, frames=frames, thresholds=thresholds, centerline=centerline)
     if probe is not None and not isinstance(probe, Probe):
         raise InputError(f"probe = {probe!r} must be a ddg.solve.probe.Probe")
     if branches is not None and not isinstance(branches, (bool, np.bool_)):
@@ -301,11 +308,12 @@ def simulate(
     extra = {"zeta": instance.zeta, "zeta_over_L": instance.zeta / strip.length} if hasattr(instance, "zeta") \
         else None
     return _static_run(model, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,
-                       frames=frames, probe=probe, summary_extra=extra)
+                       frames=frames, probe=probe, summary_extra=extra, centerline=centerline)
 
 
 def _static_run(name, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,
-                frames=False, summary_extra=None, stepper=None, result=SimulationResult, probe=None):
+                frames=False, summary_extra=None, stepper=None, result=SimulationResult, probe=None,
+                centerline=True):
     """A static run of `instance` (or of `stepper`'s model) through the driver: the rows,
     the thresholds from the model's own stability, the branches (if asked)."""
     loading = Loading.equally_spaced(strip, protocol)
@@ -314,7 +322,7 @@ def _static_run(name, instance, strip, protocol, resolution, options, out, progr
     folder = _open_folder(out, summary)
     writer = _frame_writer(instance, Path(out) / "frames") if frames else None
     bar = ProgressBar(len(loading.compression) + len(loading.shear) + 1, progress)
-    listeners, centerlines = _recorders(instance, folder, bar, writer, protocol.compression_ratio)
+    listeners, centerlines = _recorders(instance, folder, bar, writer, protocol.compression_ratio, centerline)
     stepper = stepper or StaticStepper(instance, options, probe=probe)
     after, on_compressed, branch_step = [], [], None
     extra_rows = {}
@@ -359,14 +367,15 @@ def _static_run(name, instance, strip, protocol, resolution, options, out, progr
 
 def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", zeta: float | None = None,
                resolution: int | None = None, out=None, options: ContinuationOptions | None = None,
-               thresholds: bool = True, progress: bool = False, probe: Probe | None = None) -> RibbonResult:
+               thresholds: bool = True, progress: bool = False, probe: Probe | None = None,
+               centerline: bool = True) -> RibbonResult:
     """The ribbon (Eq. A.5) through the two-stage protocol, started "direct" or from the "rod".
 
     Rows, summary and centerlines as ddg.simulate (path.csv, summary.json, centerline.csv);
     summary adds ribbon_init, zeta, zeta_over_L. init="direct" locates dW1 from the ribbon's own
     stability where its path leaves U (None if it never does); init="rod" reports the rod's
     thresholds as rod_dW1_over_L, rod_dW2_over_L and writes the rod's rows to rod_path.csv.
-    probe: as in simulate (for init="rod", the rod's solves).
+    probe, centerline: as in simulate (for init="rod", the rod's solves).
     """
     from .models.ribbon import RibbonModel
     from .models.rod import RodModel
@@ -376,6 +385,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     if not isinstance(strip, Strip) or not isinstance(protocol, LoadingProtocol):
         raise InputError("run_ribbon needs a ddg.Strip and a ddg.LoadingProtocol")
     resolution = check_resolution("ribbon", resolution)
+    _checked_flags(centerline=centerline)
     if out is not None:
         from .output.io import check_output_directory
 
@@ -387,7 +397,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     L = strip.length
     return _static_run("ribbon", ribbon, strip, protocol, resolution, options, out, progress, thresholds, False,
                        summary_extra={"ribbon_init": init, "zeta": ribbon.zeta, "zeta_over_L": ribbon.zeta / L},
-                       stepper=stepper, result=RibbonResult, probe=probe)
+                       stepper=stepper, result=RibbonResult, probe=probe, centerline=centerline)
 
 
 def simulate_dynamic(strip: Strip, protocol: LoadingProtocol, resolution: int = 100, options=None,
@@ -429,26 +439,28 @@ def simulate_dynamic(strip: Strip, protocol: LoadingProtocol, resolution: int = 
 
 def run_candidate(strip: Strip, protocol: LoadingProtocol, model: str, resolution: int, out=None,
                   options: ContinuationOptions | None = None, progress: bool = False, thresholds: bool = True,
-                  branches: bool = False, probe: Probe | None = None) -> SimulationResult:
+                  branches: bool = False, probe: Probe | None = None, centerline: bool = True) -> SimulationResult:
     """One candidate of the error map run as the map runs it (ddg.advise): the rod and the
     ribbons at M = `resolution` nodes (the Sadowsky ribbon from the flat strip, as `--model
     ribbon`), the plates on the study mesh of `resolution` rows of triangles across W
-    (ddg.advise.study_mesh); no branch tracing unless asked."""
+    (ddg.advise.study_mesh); no branch tracing unless asked; centerline as in simulate."""
     from .advise import study_mesh
 
     if model in ("plate", "plate-midedge"):
         return simulate(strip, protocol, model=model, mesh=study_mesh(model, strip, resolution), out=out,
-                        options=options, progress=progress, thresholds=thresholds, branches=branches, probe=probe)
+                        options=options, progress=progress, thresholds=thresholds, branches=branches, probe=probe,
+                        centerline=centerline)
     if model == "ribbon":
         return run_ribbon(strip, protocol, "direct", None, resolution, out=out, options=options,
-                          thresholds=thresholds, progress=progress, probe=probe)
+                          thresholds=thresholds, progress=progress, probe=probe, centerline=centerline)
     return simulate(strip, protocol, model=model, resolution=resolution, out=out, options=options, progress=progress,
-                    thresholds=thresholds, branches=branches, probe=probe)
+                    thresholds=thresholds, branches=branches, probe=probe, centerline=centerline)
 
 
 def simulate_auto(strip: Strip, protocol: LoadingProtocol, tolerance, quantities=None, error_map=None, *,
                   resolution=None, out=None, options=None, progress=False, solver="static", dynamic_options=None,
-                  mesh=None, frames=False, thresholds=True, branches=None, probe=None) -> SimulationResult:
+                  mesh=None, frames=False, thresholds=True, branches=None, probe=None,
+                  centerline=True) -> SimulationResult:
     """ddg.simulate(..., model="auto"): ddg.advise.choose on this scene, then run_candidate with
     the choice. The safe choice (outside the map, or nothing predicted within the tolerance) runs
     the plate on both meshes of its convergence pair, the coarser into out/auto_pair/R<rows>, and
@@ -466,7 +478,7 @@ def simulate_auto(strip: Strip, protocol: LoadingProtocol, tolerance, quantities
     if solver != "static" or dynamic_options is not None or frames:
         raise InputError(f"model = 'auto' runs the static solver without frames, not solver = {solver!r}"
                          + (" with frames" if frames else ""))
-    _checked_flags(progress=progress, thresholds=thresholds)
+    _checked_flags(progress=progress, thresholds=thresholds, centerline=centerline)
     if branches is not None and not isinstance(branches, (bool, np.bool_)):
         raise InputError(f"branches = {branches!r} must be True, False or None")
     options = _checked_options(options)
@@ -478,7 +490,8 @@ def simulate_auto(strip: Strip, protocol: LoadingProtocol, tolerance, quantities
     if out is not None:
         check_output_directory(out)
     branches = bool(branches) if branches is not None else False
-    common = dict(options=options, progress=progress, thresholds=thresholds, branches=branches, probe=probe)
+    common = dict(options=options, progress=progress, thresholds=thresholds, branches=branches, probe=probe,
+                  centerline=centerline)
     block = choice.auto_block()
     if choice.safe:
         coarse_rows, fine_rows = choice.resolution

@@ -61,6 +61,9 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--frames", action="store_true",
                      help="also write OUT/frames/frame_NNNNN.vtu per recorded step and OUT/frames/frames.pvd "
                           "(ParaView)")
+    sim.add_argument("--no-centerline", action="store_true",
+                     help="do not write OUT/centerline.csv (the deformed centerline per recorded step); "
+                          "path.csv and summary.json as always")
     sim.add_argument("--compression-steps", type=int, default=40, help="recorded compression steps (default 40)")
     sim.add_argument("--shear-steps", type=int, default=120, help="recorded shear steps (default 120)")
     sim.add_argument("--shear-direction", type=int, choices=(1, -1), default=1, help="+1 or -1 (default +1)")
@@ -194,6 +197,7 @@ def _require_extra(module: str, extra: str) -> None:
 def cmd_curvatures(args) -> int:
     """Curvature profiles at the requested shears: OUT/curvatures.csv and OUT/curvatures.png."""
     from .analysis.curvatures import centerline_curvatures, inflection_jumps, states_at_shears, write_curvatures_csv
+    from .output.io import save_figure
 
     from .api import check_resolution
     from .limits import check_integer
@@ -237,7 +241,7 @@ def cmd_curvatures(args) -> int:
     axes[0, 0].legend(fontsize=8)
     axes[-1, 0].set_xlabel("s / L")
     fig.tight_layout()
-    fig.savefig(out / "curvatures.png", dpi=120)
+    save_figure(fig, out / "curvatures.png", dpi=120)
     plt.close(fig)
     for rec in records:
         jumps = ", ".join(f"s/L={j['s_over_L']:.3f}: k2 jump x{j['k2_jump_ratio']:.3g}, tau "
@@ -286,7 +290,7 @@ def cmd_centerline_error(args) -> int:
     import io as _io
 
     from .analysis.centerline_approx import centerline_error_study
-    from .output.io import atomic_write_text
+    from .output.io import atomic_write_text, save_figure
 
     from .api import check_resolution
 
@@ -312,7 +316,7 @@ def cmd_centerline_error(args) -> int:
     writer.writerows(rows)
     atomic_write_text(out / "centerline_error.csv", buf.getvalue())
     fig = centerline_error_figure(rows, shears)
-    fig.savefig(out / "centerline_error.png", dpi=120)
+    save_figure(fig, out / "centerline_error.png", dpi=120)
     import matplotlib.pyplot as plt
 
     plt.close(fig)
@@ -369,7 +373,8 @@ def cmd_simulate(args) -> int:
         if args.solver != "static" or args.mesh is not None or args.frames:
             raise InputError("--model ribbon runs the static solver only, without --mesh or --frames")
         result = run_ribbon(strip, protocol, args.ribbon_init or "direct", args.zeta, args.resolution, out=args.out,
-                            options=options, thresholds=not args.no_thresholds, progress=not args.quiet)
+                            options=options, thresholds=not args.no_thresholds, progress=not args.quiet,
+                            centerline=not args.no_centerline)
     elif args.ribbon_init is not None or (args.zeta is not None and args.model != "ribbon-wunderlich"):
         raise InputError(f"--zeta applies to --model ribbon and ribbon-wunderlich, --ribbon-init to --model "
                          f"ribbon only, not {args.model!r}")
@@ -377,7 +382,7 @@ def cmd_simulate(args) -> int:
         result = simulate(strip, protocol, args.model, args.resolution, out=args.out, options=options,
                           progress=not args.quiet, solver=args.solver, dynamic_options=dynamic_options,
                           mesh=args.mesh, frames=args.frames, thresholds=not args.no_thresholds,
-                          branches=args.branches, zeta=args.zeta)
+                          branches=args.branches, zeta=args.zeta, centerline=not args.no_centerline)
     return _finish_simulate(args, result)
 
 
@@ -461,7 +466,7 @@ def cmd_simulate_auto(args, strip: Strip, protocol: LoadingProtocol) -> int:
                                   branch_sign=1 if args.branch == "+" else -1)
     result = simulate(strip, protocol, "auto", out=args.out, options=options, progress=not args.quiet,
                       thresholds=not args.no_thresholds, branches=args.branches, tolerance=tolerance,
-                      quantities=quantities, error_map=args.error_map)
+                      quantities=quantities, error_map=args.error_map, centerline=not args.no_centerline)
     return _finish_simulate(args, result, auto=True)
 
 

@@ -71,10 +71,10 @@ class _SummaryModel:
 def _base_summary(strip, protocol, resolution, model) -> dict:
     from ddg.protocol.results import base_summary
 
-    from .shell import EIGEN_NORMALISATION, FULL_DEGREE, REDUCED_DEGREE
+    from .shell import EIGEN_NORMALISATION
 
-    mesh = {**model.spec.as_dict(), "element": "Naghdi shell: u in [P2 + B3]^3, theta in [P2]^2",
-            "locking": f"PSRI, alpha = b^2/h^2, full degree {FULL_DEGREE}, reduced degree {REDUCED_DEGREE}"}
+    element = model.shell_element  # fem_reference.elements.ShellElement
+    mesh = {**model.spec.as_dict(), "element": element.description, "locking": element.locking}
     summary = base_summary("fem", strip, protocol, resolution, _SummaryModel(model.n_dof, model.free, mesh))
     summary["scene"]["clamp_convention"] = ("clamped edges x = 0 and x = L of the mesh: displacement prescribed, "
                                             "both rotation angles zero; free length exactly L")
@@ -111,17 +111,18 @@ def check_perturbation(value, name: str = "perturbation") -> float:
 
 
 def check_inputs(strip, protocol, resolution, across=None, material: str = "isotropic", out=None,
-                 perturbation=None, names: dict | None = None):
+                 perturbation=None, names: dict | None = None, element: str = "P2B3"):
     """Every input of a run checked before any FEM import or work, with one-line ddg InputErrors
     named as in `names` (the command line passes its option names). Returns the MeshSpec and
     the output directory (None without `out`)."""
     from .mesh import checked_spec
 
     names = {"resolution": "resolution", "across": "across", "out": "out", "perturbation": "perturbation",
-             **(names or {})}
+             "element": "element", **(names or {})}
     if not isinstance(strip, Strip) or not isinstance(protocol, LoadingProtocol):
         raise InputError("simulate needs a ddg Strip and a ddg LoadingProtocol")
-    spec = checked_spec(resolution, strip.width_ratio, across, names["resolution"], names["across"])
+    spec = checked_spec(resolution, strip.width_ratio, across, names["resolution"], names["across"],
+                        element, names["element"])
     if not isinstance(material, str) or material not in MATERIALS:
         raise InputError(f"material = {material!r} is not one of {MATERIALS}")
     if material == "dep" and strip.poisson_ratio != 0.0:
@@ -140,11 +141,15 @@ def check_inputs(strip, protocol, resolution, across=None, material: str = "isot
 
 def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_RESOLUTION, out=None,
              options=None, across: int | None = None, fields: bool = True, progress: bool = False,
-             newton_options=None, material: str = "isotropic") -> FemResult:
+             newton_options=None, material: str = "isotropic", centerline: bool = True,
+             element: str = "P2B3") -> FemResult:
     """Run the two-stage protocol on the Naghdi shell with `resolution` elements along L.
 
     material: "isotropic" (the strip's Poisson ratio; the paper's shell) or "dep" (the DDG
-    plate's continuum limit, fem_reference.shell.ShellParameters).
+    plate's continuum limit, fem_reference.shell.ShellParameters). centerline=False records no
+    centerline (no centerline.csv: the gold and mesh studies read path.csv and summary.json only).
+    element: the shell's finite element, "P2B3" (default) or "P3" (fem_reference.elements; recorded
+    in summary.json's mesh.element).
 
     The loop is ddg.protocol's (ddg.protocol.driver.execute) with the shell as its stepper
     (fem_reference.protocol.ShellStepper: the branch switch at the first unstable U state) and
@@ -168,11 +173,11 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
 
     from .mesh import keep_python_sigint
 
-    for name, value in (("fields", fields), ("progress", progress)):
+    for name, value in (("fields", fields), ("progress", progress), ("centerline", centerline)):
         if not isinstance(value, (bool, np.bool_)):
             raise InputError(f"{name} = {value!r} must be True or False")
     spec, directory = check_inputs(strip, protocol, resolution, across, material, out,
-                                   getattr(options, "perturbation", None))
+                                   getattr(options, "perturbation", None), element=element)
     resolution = int(resolution)  # checked integral by check_inputs
     folder = RunFolder(directory, trailing=FEM_COLUMNS) if directory is not None else None  # old results removed
     sigint = signal.getsignal(signal.SIGINT)
@@ -207,7 +212,7 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
         folder.checkpoint(summary)
     try:
         return _execute(strip, protocol, model, solver, shell, summary, folder,
-                        directory if fields else None, progress, t_build)
+                        directory if fields else None, progress, t_build, centerline)
     except BaseException as exc:
         where = None if directory is None else str(directory)
         try:
@@ -222,7 +227,8 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
             folder.close()
 
 
-def _execute(strip, protocol, model, solver, shell, summary, folder, fields_directory, progress, t_build):
+def _execute(strip, protocol, model, solver, shell, summary, folder, fields_directory, progress, t_build,
+             centerline=True):
     """The run through ddg.protocol.driver.execute: listeners (path.csv, centerlines, XDMF
     fields, progress lines), the threshold after-steps, the FEM's timing keys."""
     from ddg.protocol.driver import Loading, Run, execute
@@ -234,7 +240,8 @@ def _execute(strip, protocol, model, solver, shell, summary, folder, fields_dire
     xdmf = _FieldWriter(model, clock, fields_directory)
 
     def keep(stage, observed, row):
-        centerlines.append(shell.observer.centerline(CENTERLINE_STATIONS))
+        if centerline:
+            centerlines.append(shell.observer.centerline(CENTERLINE_STATIONS))
         xdmf.write(row)  # before path.csv: it sets the row's xdmf_time
         if folder is not None:
             with clock.section("I/O"):

@@ -14,6 +14,9 @@ import json
 import os
 import sys
 
+from ddg.sweep.cluster import add_options as cluster_options
+
+from .elements import DEFAULT_ELEMENT, ELEMENTS
 from .scene import add_scene_options, scene_from_args
 
 EXIT_FAILURE = 1
@@ -28,7 +31,8 @@ class _Parser(argparse.ArgumentParser):
 
 
 #: Option names of the command line, for api.check_inputs' messages.
-OPTION_NAMES = {"resolution": "--resolution", "across": "--across", "out": "--out", "perturbation": "--perturbation"}
+OPTION_NAMES = {"resolution": "--resolution", "across": "--across", "out": "--out", "perturbation": "--perturbation",
+                "element": "--element"}
 
 
 def _thresholds_note(s: dict) -> str:
@@ -43,14 +47,15 @@ def cmd_simulate(args) -> int:
     strip, protocol = scene_from_args(args)
     # every input checked before dolfinx is imported (api.simulate checks them again, cheaply)
     check_inputs(strip, protocol, args.resolution, args.across, args.material, args.out, args.perturbation,
-                 names=OPTION_NAMES)
+                 names=OPTION_NAMES, element=args.element)
     from .api import simulate
     from .continuation import ContinuationOptions
 
     options = ContinuationOptions(perturbation=args.perturbation, branch_switching=not args.no_branch_switching,
                                   thresholds=not args.no_thresholds)
     result = simulate(strip, protocol, args.resolution, out=args.out, options=options, across=args.across,
-                      fields=not args.no_fields, progress=not args.quiet, material=args.material)
+                      fields=not args.no_fields, progress=not args.quiet, material=args.material,
+                      centerline=not args.no_centerline, element=args.element)
     args.finished_in = args.out or ""  # for the message of a Ctrl-C from here on
     s = result.summary
     if not args.quiet:
@@ -97,8 +102,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--material", choices=("isotropic", "dep"), default="isotropic",
                    help="isotropic (the strip's Poisson ratio, default) or dep: the DDG plate's continuum limit "
                         "(nu = 1/3 membrane, nu_b = -1/3 bending, D = E b^3/12)")
+    p.add_argument("--element", choices=tuple(ELEMENTS), default=DEFAULT_ELEMENT,
+                   help="the shell's finite element: P2B3 (u in [P2 + B3]^3, theta in [P2]^2, default) or P3 "
+                        "(u in [P3]^3, theta in [P3]^2)")
     p.add_argument("--no-thresholds", action="store_true")
     p.add_argument("--no-fields", action="store_true", help="skip fields.xdmf")
+    p.add_argument("--no-centerline", action="store_true", help="skip centerline.csv")
     p.add_argument("--out", default=None, help="output directory (default: nothing written)")
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_simulate)
@@ -123,6 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--studies-only", action="store_true",
                    help="no run: rewrite each selected scene's study (richardson.json, convergence.*) and the index "
                         "from its finished runs")
+    cluster_options(p)  # --workers, --scheduler, --retries: the runs are Dask tasks, as the DDG sweep's
     p.add_argument("--quiet", action="store_true")
     p.set_defaults(func=cmd_gold)
     return parser

@@ -1,20 +1,30 @@
 """Gold data: the FEM reference on the paper's scenes (section 4: dL/L in {1/2, 1/4} x W/L in
 {1/20, 1/12, 1/6, 1/3, 1/2}) with error bars from a mesh study,
-`python -m fem_reference gold --out data/fem_gold [--only NAME ...] [--resolution N] [--levels K]`.
+`python -m fem_reference gold --out data/fem_gold [--only NAME ...] [--resolution N] [--levels K]
+[--workers N | --scheduler ADDRESS] [--retries 2]`.
 
 Every scene is run on LEVELS meshes refined uniformly by REFINEMENT = 1.5 in both directions
 (along L: 64, 96, 144 elements; across W: BASE_ACROSS[W/L] times 1, 1.5, 2.25), each the whole
 path with dW1 and dW2 bisected to GOLD_TOLERANCES, into OUT/<name>/N<along>x<across>/ (path.csv,
-summary.json, centerline.csv; no XDMF to keep the data small), name = dL<dL/L>_W<W/L> e.g.
-dL0.5_W0.1667. After each run the scene's mesh study is rewritten from the runs that exist
+summary.json; no centerline.csv or XDMF, which no study reads, to keep the data small), name =
+dL<dL/L>_W<W/L> e.g. dL0.5_W0.1667. After each run the scene's mesh study is rewritten from the runs that exist
 (OUT/<name>/richardson.json, convergence.md, convergence.csv, thresholds.csv: Richardson
 extrapolation with error bars, fem_reference.convergence.estimate), then OUT/index.json and
 OUT/README.md. Resumable run by run: a finished run (status complete or stopped) on the same
-mesh and tolerances is kept; Ctrl-C loses only the run in progress.
+mesh and tolerances is kept; Ctrl-C loses only the runs in progress (exit 130).
+
+The runs are Dask tasks, as `python -m ddg sweep`'s (ddg.sweep.cluster): by default on a
+LocalCluster of one single-threaded worker process per core (--workers N), with --scheduler on an
+existing cluster whose workers share OUT and the checkout; each worker writes its run's folder and
+imports dolfinx, the client rewrites the studies and the index as each run ends. A worker killed
+mid-run costs that run, which is retried (--retries).
 """
 from __future__ import annotations
 
+import hashlib
 import json
+import math
+import sys
 import time
 from pathlib import Path
 
@@ -25,6 +35,9 @@ COMPRESSION_RATIOS = (1 / 2, 1 / 4)
 #: The mesh study: LEVELS meshes, each REFINEMENT times finer than the last in both directions.
 REFINEMENT = 1.5
 LEVELS = 3
+#: The most levels a study has (a fourth mesh, 216 elements along L, where the first three are not
+#: asymptotic: issue 28).
+MAX_LEVELS = 4
 #: Elements along L of the coarsest mesh (64, 96, 144 with the defaults; a multiple of 8 keeps
 #: the ratios exact). 40 is not in the asymptotic range of the thresholds: at W/L = 1/6, dL/L = 1/2
 #: the meshes 40 x 8, 60 x 12, 90 x 18 gave dW1/L 0.2585, 0.2570, 0.2615 and dW2/L 0.4851,
@@ -54,12 +67,16 @@ def mesh_sequence(width_ratio: float, base: int = BASE_RESOLUTION, levels: int =
     """(elements along L, elements across W) of each mesh of a scene's study, coarsest first
     (counts rounded up to even; exact 1.5 ratios for base a multiple of 8)."""
     across = next(v for w, v in BASE_ACROSS.items() if abs(w - width_ratio) < 1e-9)
+    return refined_sequence(base, across, levels)
 
+
+def refined_sequence(along: int, across: int, levels: int) -> list[tuple[int, int]]:
+    """`levels` meshes from (along, across), each REFINEMENT times finer (counts rounded up to even)."""
     def even(x: float) -> int:
         n = int(round(x)) if abs(x - round(x)) < 1e-9 else int(x) + 1
         return n + (n % 2)
 
-    return [(even(base * REFINEMENT**k), even(across * REFINEMENT**k)) for k in range(levels)]
+    return [(even(along * REFINEMENT**k), even(across * REFINEMENT**k)) for k in range(levels)]
 
 
 def run_folder_name(along: int, across: int) -> str:
@@ -93,7 +110,8 @@ def _read_summary(path: Path) -> dict | None:
 def check_gold_inputs(args) -> list[tuple[str, float, float, list[tuple[int, int]]]]:
     """The scenes to run as (name, dL/L, W/L, meshes), every input checked before any work:
     --only names known, --levels in 1..4, every mesh of every selected scene within the mesh
-    bounds and memory (mesh.checked_spec), --out writable. One-line InputError otherwise."""
+    bounds and memory (mesh.checked_spec), the cluster options (cluster_inputs: dask importable
+    unless --studies-only), --out writable. One-line InputError otherwise."""
     from ddg.geometry.strip import InputError
     from ddg.limits import check_integer
     from ddg.output.io import check_output_directory
@@ -120,6 +138,7 @@ def check_gold_inputs(args) -> list[tuple[str, float, float, list[tuple[int, int
         for along, across in meshes:
             checked_spec(along, W, across, f"--resolution (mesh {along} x {across} of the study)")
         selected.append((name, dL, W, slenderness, meshes))
+    cluster_inputs(args)
     check_output_directory(args.out, "--out")
     return selected
 
@@ -135,10 +154,58 @@ def _finished(summary: dict | None, along: int, across: int) -> bool:
         (tolerances.get("dW1"), tolerances.get("dW2")) == GOLD_TOLERANCES
 
 
-def run_gold(args) -> int:
+def cluster_inputs(args) -> tuple[str | None, int | None, int]:
+    """(scheduler, workers, retries) of --scheduler, --workers, --retries, checked
+    (ddg.sweep.cluster.checked_options), and dask importable unless --studies-only: the scheduler
+    to use, None for a LocalCluster. One-line InputError otherwise."""
+    from ddg.sweep.cluster import checked_options, ready
+
+    scheduler, workers, retries = checked_options(getattr(args, "scheduler", None), getattr(args, "workers", None),
+                                                  getattr(args, "retries", 2))
+    if not getattr(args, "studies_only", False):
+        scheduler = ready(scheduler, workers)
+    return scheduler, workers, retries
+
+
+def run_mesh(compression_ratio: float, width_ratio: float, slenderness: float | None, along: int, across: int,
+             target: str) -> dict:
+    """One run of a study, in a Dask worker (dolfinx is imported here): the whole path on `along` x
+    `across` elements, dW1 and dW2 bisected to GOLD_TOLERANCES, into `target` (path.csv,
+    summary.json). Returns its status, dW1_over_L, dW2_over_L, converged and wall_time_s; a run
+    an earlier attempt finished is returned as stored; a run that raised gives {"error": one line}
+    (not retried: it would fail again), its converged part written with status "error"."""
     from ddg.geometry.strip import LoadingProtocol, Strip
 
-    selected = check_gold_inputs(args)  # before any FEM import
+    t0 = time.perf_counter()
+    summary = _read_summary(Path(target) / "summary.json")
+    if not _finished(summary, along, across):
+        from .api import simulate
+        from .continuation import ContinuationOptions
+
+        options = ContinuationOptions(dw1_tolerance=GOLD_TOLERANCES[0], dw2_tolerance=GOLD_TOLERANCES[1])
+        strip = Strip.from_ratios(width_ratio, compression_ratio, slenderness)
+        try:
+            summary = simulate(strip, LoadingProtocol(compression_ratio), along, out=target, across=across,
+                               fields=False, options=options, progress=False, centerline=False).summary
+        except Exception as exc:  # noqa: BLE001  (reported by the client, one line)
+            need = "the FEM reference needs dolfinx 0.5, petsc4py, slepc4py, mpi4py and gmsh: " \
+                if isinstance(exc, ImportError) else ""
+            return {"error": f"{need}{type(exc).__name__}: {' '.join(str(exc).split())}",
+                    "wall_time_s": time.perf_counter() - t0}
+    return {**{k: summary.get(k) for k in ("status", "dW1_over_L", "dW2_over_L")},
+            "converged": bool(summary.get("converged")), "wall_time_s": time.perf_counter() - t0}
+
+
+def run_gold(args) -> int:
+    """The gold command: each unfinished run of the selected scenes a Dask task (ddg.sweep.cluster:
+    a LocalCluster of --workers processes, or the cluster at --scheduler), written by its worker
+    into OUT/<scene>/N<along>x<across>/; here, as each one ends, its scene's study and the index.
+    Exit 0, 3 if a run stopped short, 1 if one failed; Ctrl-C keeps the finished runs."""
+    from ddg.output.interrupts import deferred_signals, signal_name_of
+    from ddg.sweep.cluster import Task, run_all
+    from ddg.sweep.grid import code_version
+
+    selected = check_gold_inputs(args)  # before any FEM import and any work
 
     out = Path(args.out)
     if getattr(args, "studies_only", False):   # no FEM import: the studies read the stored runs
@@ -148,33 +215,48 @@ def run_gold(args) -> int:
         write_index(out)
         return 0
 
-    from .api import simulate
-    from .continuation import ContinuationOptions
+    scheduler, workers, retries = cluster_inputs(args)
+    where = hashlib.sha256(str(out.resolve()).encode()).hexdigest()[:8]
+    tasks = []
+    for name, dL, W, slenderness, meshes in selected:
+        for along, across in meshes:
+            target = out.resolve() / name / run_folder_name(along, across)
+            if _finished(_read_summary(target / "summary.json"), along, across):
+                continue
+            tasks.append(Task(f"fem-gold-{name}-{run_folder_name(along, across)}-{where}", run_mesh,
+                              (dL, W, slenderness, along, across, str(target)), along * across,
+                              (name, along, across, meshes)))
+    failed, stopped = [], []
 
-    options = ContinuationOptions(dw1_tolerance=GOLD_TOLERANCES[0], dw2_tolerance=GOLD_TOLERANCES[1])
-    status = 0
-    try:
-        for name, dL, W, slenderness, meshes in selected:
-            for along, across in meshes:
-                target = out / name / run_folder_name(along, across)
-                if _finished(_read_summary(target / "summary.json"), along, across):
-                    continue
-                strip = Strip.from_ratios(W, dL, slenderness)
-                t0 = time.perf_counter()
-                result = simulate(strip, LoadingProtocol(dL), along, out=target, across=across, fields=False,
-                                  options=options, progress=False)
-                if not args.quiet:
-                    print(f"{name} {along} x {across}: {result.summary['status']}, {time.perf_counter() - t0:.0f} s, "
-                          f"dW1/L {result.summary['dW1_over_L']}, dW2/L {result.summary['dW2_over_L']}", flush=True)
-                status = status or (0 if result.converged else 3)
+    def finished(task, result, error):
+        name, along, across, meshes = task.tag
+        error = error or (result or {}).get("error")
+        if error is not None:
+            failed.append(task)
+            print(f"error: {name} {along} x {across}: {error}", file=sys.stderr, flush=True)
+        else:
+            if not args.quiet:
+                print(f"{name} {along} x {across}: {result['status']}, {result['wall_time_s']:.0f} s, "
+                      f"dW1/L {result['dW1_over_L']}, dW2/L {result['dW2_over_L']}", flush=True)
+            if not result["converged"]:
+                stopped.append(task)
+        write_scene_study(out / name, meshes)
+        write_index(out)
+
+    ran = run_all(tasks, finished, scheduler=scheduler, workers=workers, retries=retries, code=code_version(),
+                  shared=out)
+    with deferred_signals():  # the index lists what is finished, also after Ctrl-C
+        if ran.interrupted is not None:  # runs that ended while the client was stopping
+            for name, meshes in {task.tag[0]: task.tag[3] for task in tasks}.items():
                 write_scene_study(out / name, meshes)
-                write_index(out)
-    finally:  # also after Ctrl-C: the index lists what is finished
-        from ddg.output.interrupts import deferred_signals
-
-        with deferred_signals():
-            write_index(out)
-    return status
+        write_index(out)
+    if ran.interrupted is not None:
+        done = sum(_finished(_read_summary(Path(t.args[5]) / "summary.json"), t.args[3], t.args[4]) for t in tasks)
+        ran.interrupted.run_message = (f"interrupted by {signal_name_of(ran.interrupted)}: {done} of {len(tasks)} "
+                                       f"runs finished and kept in {out}; a rerun computes only the other "
+                                       f"{len(tasks) - done}")
+        raise ran.interrupted
+    return 1 if failed else 3 if stopped else 0
 
 
 def scene_runs(folder: Path, meshes=None) -> list[tuple[int, int, Path]]:
@@ -193,19 +275,26 @@ def scene_runs(folder: Path, meshes=None) -> list[tuple[int, int, Path]]:
 
 def write_scene_study(folder: Path, meshes=None) -> dict | None:
     """The scene's mesh study from its finished runs (fem_reference.convergence): convergence.md,
-    convergence.csv, thresholds.csv and richardson.json in the scene folder; None with no run."""
+    convergence.csv, thresholds.csv and richardson.json in the scene folder; None with no run.
+    With `meshes` (a gold sequence), the runs of every level of that sequence up to MAX_LEVELS
+    that exist: a fourth mesh run with --levels 4 stays in the study when it is rewritten with the
+    default three. The refinement ratios are those of sqrt(along x across) (Celik's N^(1/2)):
+    the fourth level's across-count is rounded up to even (8 x 3.375 = 27 -> 28)."""
     from ddg.geometry.strip import LoadingProtocol, Strip
     from ddg.output.io import StoredRun
 
     from .convergence import study_estimates, summarise, write_outputs
 
+    if meshes:  # every level of the scene's sequence that has a run, not only those asked for
+        meshes = list(dict.fromkeys(list(meshes) + refined_sequence(*meshes[0], MAX_LEVELS)))
     found = scene_runs(folder, meshes)
     if not found:
         return None
     runs = [StoredRun(str(path)) for _, _, path in found]
     resolutions = [along for along, _, _ in found]
+    sizes = [math.sqrt(along * across) for along, across, _ in found]
     scene = runs[-1].summary["scene"]
-    estimates = study_estimates(runs, resolutions)
+    estimates = study_estimates(runs, resolutions, sizes=sizes)
     sheared = [(n, r) for n, r in zip(resolutions, runs) if any(row["stage"] == "shear" for row in r.rows)]
     if len(sheared) >= 2:
         rows, table = summarise([r for _, r in sheared], [n for n, _ in sheared])
@@ -217,11 +306,15 @@ def write_scene_study(folder: Path, meshes=None) -> dict | None:
                          "n_dof": r.summary["n_dof"], "wall_time_s": r.summary["wall_time_s"],
                          "newton_iterations": r.summary["newton_iterations"],
                          "dW1_over_L": r.summary["dW1_over_L"], "dW2_over_L": r.summary["dW2_over_L"],
-                         "H_mid_over_L_compressed": r.summary["H_mid_over_L_compressed"]}
-                        for (a, c, p), r in zip(found, runs)],
+                         "H_mid_over_L_compressed": r.summary["H_mid_over_L_compressed"],
+                         "linear_resolution": h}
+                        for (a, c, p), r, h in zip(found, runs, sizes)],
              "refinement_ratio": REFINEMENT, "threshold_tolerances_over_L": list(GOLD_TOLERANCES),
              **estimates}
     atomic_write_text(folder / "richardson.json", json.dumps(study, indent=2) + "\n")
+    from .series import write_series
+
+    write_series(folder)  # the scene's independent mesh series, where it has some (fem_reference.series.SERIES)
     return study
 
 
@@ -275,24 +368,42 @@ Regenerate (run by run, finished runs are kept; a few hours on one core):
 
 Each scene (names dL<dL/L>_W<W/L>: dL0.5_W0.05, dL0.5_W0.08333, dL0.5_W0.1667, dL0.5_W0.3333,
 dL0.5_W0.5, dL0.25_W0.05, ...) is run on three meshes refined by 1.5 in both directions (64, 96,
-144 elements along L; across W 8/12/18 for W/L <= 1/6, 16/24/36 for 1/3, 24/36/54 for 1/2), dW1
-and dW2 bisected to 1e-4 L. Each run folder N<along>x<across>/ holds path.csv, summary.json and
-centerline.csv (the DDG output contract); the scene folder holds the study: richardson.json,
-convergence.md. A scene folder with a single run at its top level is from before the studies
-(60 elements, dW2 to 1e-3 L); the report's H_mid figures still draw it, while the claims and the
-benchmark use the studies' converged values (validation/estimates.py). Runs of other meshes in a
-scene folder are kept as evidence (W/L = 1/6: 40 x 8, 60 x 12, 90 x 18, not asymptotic:
-convergence_40_60_90.md) and are not part of its study. Below the paper's ten, the error map's
+144 elements along L; across W 8/12/18 for W/L <= 1/6, 16/24/36 for 1/3, 24/36/54 for 1/2), and a
+fourth (216 x 28, 216 x 54, 216 x 82; `--levels 4`) where the first three are not asymptotic, stop
+short or converge at an order below 1.5; dW1 and dW2 bisected to 1e-4 L. Each run folder
+N<along>x<across>/ holds path.csv and summary.json (no centerline.csv: no study reads it); the
+scene folder holds the study: richardson.json, convergence.md. A scene folder with a single run at
+its top level is from before the studies (60 elements, dW2 to 1e-3 L); the report's H_mid figures
+still draw it, while the claims and the benchmark use the studies' converged values
+(validation/estimates.py). Runs of other meshes in a scene folder are kept as evidence and are not
+part of its study (W/L = 1/6: 40 x 8, 60 x 12, 90 x 18, not asymptotic: convergence_40_60_90.md;
+the independent series of fem_reference/series.py, compared in series.md). Below the paper's ten, the error map's
 scenes (fem_reference.gold.MAP_SCENES, `--only NAME`, names with _Lb<L/b> for another strip) are
 listed as far as they have been run; the error map (validation/error_map.py) uses one from two meshes.
 
-Error bars (fem_reference.convergence.estimate): with three meshes whose differences shrink
-monotonically and an observed order p in [1, 4], the value is the Richardson extrapolation and
-the error bar 1.25 |f3 - f2| / (r^p - 1) (Roache's grid convergence index on the finest mesh); otherwise
-the value is the finest mesh's, the error bar the spread of the finest two |f3 - f2| (times 3
-when the differences do not shrink), flagged "not asymptotic". The same estimate is made at every
-recorded dW of the common grid for H_mid/L (richardson.json `H_mid_curve`) and for the clamp
-force F_shear L/(E b^3) (`F_shear_curve`), up to the smallest dW all meshes reached.
+## The error-bar rule (fem_reference.convergence.estimate, rule 2, issue 28)
+
+Of the finest three meshes of a study with a value, f1, f2, f3 (coarse to fine), d1 = f2 - f1,
+d2 = f3 - f2, refinement ratios from sqrt(along x across) (1.5, and 1.53 to the fourth mesh whose
+across-count is rounded up to even), observed order p from the error model f* + C h^p (Celik et
+al. 2008; ln|d1/d2| / ln 1.5 for equal ratios):
+
+- asymptotic (d1, d2 of one sign, p in [1, 4]): the value is the Richardson extrapolation
+  f3 + d2/(r^p - 1), the error bar Fs |d2|/(r^p - 1) (Roache's grid convergence index of the finest
+  mesh) with Fs = 1.25 for p >= 1.5 and Fs = 3 for p < 1.5 (a low order is not a confirmed one);
+- not asymptotic (differences of opposite sign, not shrinking, or p outside [1, 4]): the value is
+  the finest mesh's, the error bar 3 max(|d1|, |d2|), and where p < 1 with both differences beyond
+  the bisection bracket at least |d2|/(r^p - 1), the distance to the limit at the observed order
+  (p counted as at least 0.5: a slower sequence has not begun to converge);
+- two meshes: the finest value, 3 |f2 - f1|; one mesh: no error bar (the benchmark asks three);
+- a threshold's bisection bracket (dW1: half of 1e-4, dW2: 1e-4) is added to its error bar.
+
+The same estimate is made at every recorded dW for H_mid/L (richardson.json `H_mid_curve`) and
+the clamp force F_shear L/(E b^3) (`F_shear_curve`), from the meshes that reached that dW (a
+curve ends where fewer than two go on). Until issue 28 (rule 1) a non-asymptotic sequence whose
+differences shrank got |d2| alone and every order 1.25; at W/L = 1/6, dL/L = 1/2 that bar (0.0010)
+was 3.5 times smaller than the distance to an independent isotropic mesh series' extrapolation.
+Tested on constructed sequences in tests/test_fem_gold_study.py.
 `--studies-only` rewrites the studies and this file from the stored runs without running any.
 
 ## What exists (written by the gold command)
@@ -321,7 +432,8 @@ def write_readme(out: Path, index: dict) -> None:
         for key, single in (("dW1", "dW1_over_L"), ("dW2", "dW2_over_L")):
             est = study.get(key)
             if est:
-                flag = "" if est["asymptotic"] else " (not asymptotic)"
+                flag = "" if est["asymptotic"] else \
+                    f" ({len(est['meshes'])} meshes)" if len(est["meshes"]) < 3 else " (not asymptotic)"
                 cells += [fmt(est["value"]), fmt(est["error_bar"]), fmt(est["order"], "{:.2f}") + flag]
             else:
                 cells += [fmt(e[single]), "-", "-"]

@@ -16,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .elements import DEFAULT_ELEMENT, ELEMENTS, check_element
+
 CLAMP_START = 1  # physical tag of the edge x = 0
 CLAMP_END = 2  # physical tag of the edge x = L
 SURFACE = 10
@@ -56,9 +58,12 @@ class MeshSpec:
     nx: int
     ny: int
     width_ratio: float
+    #: the shell's finite element on this mesh (fem_reference.elements.ELEMENTS)
+    element: str = DEFAULT_ELEMENT
 
     @classmethod
-    def from_resolution(cls, resolution: int, width_ratio: float, across: int | None = None) -> "MeshSpec":
+    def from_resolution(cls, resolution: int, width_ratio: float, across: int | None = None,
+                        element: str = DEFAULT_ELEMENT) -> "MeshSpec":
         """resolution elements along L; across W near-isotropic (nx W/L) but never fewer than
         MIN_ELEMENTS_ALONG_FOR_WIDTH * W/L, and at least 2; both rounded up to even counts."""
         nx = 2 * math.ceil(resolution / 2)
@@ -66,13 +71,14 @@ class MeshSpec:
             across = max(math.ceil(nx * width_ratio - 1e-9),
                          math.ceil(MIN_ELEMENTS_ALONG_FOR_WIDTH * width_ratio - 1e-9), 2)
         ny = 2 * math.ceil(across / 2)
-        return cls(nx, ny, float(width_ratio))
+        return cls(nx, ny, float(width_ratio), element)
 
     @property
     def n_dof(self) -> int:
-        """Unknowns of the Naghdi discretisation (shell.NaghdiStrip): u in [P2 + B3]^3, theta in
-        [P2]^2; the structured mesh has (2 nx + 1)(2 ny + 1) P2 nodes and 2 nx ny bubbles."""
-        return 5 * (2 * self.nx + 1) * (2 * self.ny + 1) + 3 * self.n_triangles
+        """Unknowns of the Naghdi discretisation (shell.NaghdiStrip) with this spec's element
+        (elements.ShellElement.n_dof): for the default u in [P2 + B3]^3, theta in [P2]^2, the
+        structured mesh has (2 nx + 1)(2 ny + 1) P2 nodes and 2 nx ny bubbles."""
+        return ELEMENTS[self.element].n_dof(self.nx, self.ny)
 
     def estimated_memory_bytes(self) -> float:
         """Peak memory of a run on this mesh (see BYTES_PER_DOF)."""
@@ -105,12 +111,16 @@ class MeshSpec:
 
 
 def checked_spec(resolution, width_ratio: float, across=None, name: str = "--resolution",
-                 across_name: str = "--across") -> MeshSpec:
-    """The MeshSpec of `resolution` elements along L (and `across` across W), refused with a
-    one-line ddg InputError before any FEM work when a count is outside its bounds
-    (MIN/MAX_RESOLUTION, MIN/MAX_ACROSS) or the mesh needs more memory than this machine allows
-    (ddg.limits.check_memory with MeshSpec.estimated_memory_bytes)."""
+                 across_name: str = "--across", element: str = DEFAULT_ELEMENT,
+                 element_name: str = "element") -> MeshSpec:
+    """The MeshSpec of `resolution` elements along L (and `across` across W) with the shell
+    `element`, refused with a one-line ddg InputError before any FEM work when the element is
+    unknown (elements.check_element), a count is outside its bounds (MIN/MAX_RESOLUTION,
+    MIN/MAX_ACROSS) or the mesh needs more memory than this machine allows (ddg.limits.check_memory
+    with MeshSpec.estimated_memory_bytes)."""
     from ddg.limits import check_integer, check_memory
+
+    check_element(element, element_name)
 
     resolution = check_integer(name, resolution, MIN_RESOLUTION, MAX_RESOLUTION,
                                f"elements along L: at least {MIN_RESOLUTION} to hold the buckle, at most "
@@ -119,7 +129,7 @@ def checked_spec(resolution, width_ratio: float, across=None, name: str = "--res
         across = check_integer(across_name, across, MIN_ACROSS, MAX_ACROSS,
                                f"elements across W: at least {MIN_ACROSS}, an even count (odd ones are rounded up) "
                                f"so that a vertex sits at the centre (L/2, 0); at most {MAX_ACROSS}")
-    spec = MeshSpec.from_resolution(resolution, width_ratio, across)
+    spec = MeshSpec.from_resolution(resolution, width_ratio, across, element)
     if spec.ny > MAX_ACROSS:
         check_integer(f"elements across W (from {name} {resolution} and W/L = {width_ratio:.4g})", spec.ny,
                       MIN_ACROSS, MAX_ACROSS)
@@ -151,8 +161,10 @@ def import_gmsh():
     gmsh.py sets SIGINT to SIG_DFL as its first action on import, before it loads libgmsh (a
     large library, tenths of a second): a Ctrl-C in that window would kill the process silently,
     so signal.signal ignores that one call while gmsh is imported (main thread only; gmsh then
-    records the handler in force as the one gmsh.finalize() restores)."""
-    if "gmsh" in sys.modules or threading.current_thread() is not threading.main_thread():
+    records the handler in force as the one gmsh.finalize() restores). Off the main thread (a
+    Dask worker runs its tasks in a thread), where a signal handler cannot be set at all, the call
+    is skipped alike and gmsh is left no handler to restore, so that finalize() does not fail."""
+    if "gmsh" in sys.modules:
         import gmsh
 
         return gmsh
@@ -168,6 +180,8 @@ def import_gmsh():
         import gmsh
     finally:
         signal.signal = original
+    if threading.current_thread() is not threading.main_thread():
+        gmsh.oldsig = None  # gmsh.finalize() restores SIGINT only if it has a handler to restore
     return gmsh
 
 

@@ -35,15 +35,19 @@ written here for a flat reference configuration and dolfinx 0.5.2):
   (Seung-Nelson: bending modulus D, Gaussian modulus -4/3 D). A narrow strip then bends with
   8/9 EI2 and twists with GJ = 8/3 D W, as the DEP does; this is for separating the DEP's
   discretisation error from its modelling difference to the nu = 0 shell of the paper.
-* Discretisation: u in [P2 + B3]^3 (quadratic Lagrange enriched by the cubic bubble), theta in
-  [P2]^2 on triangles. Locking (shear and membrane) is treated by partial selective reduced
+* Discretisation (MeshSpec.element, fem_reference.elements): by default u in [P2 + B3]^3
+  (quadratic Lagrange enriched by the cubic bubble), theta in [P2]^2 on triangles; "P3": u in
+  [P3]^3, theta in [P3]^2. Locking (shear and membrane) is treated by partial selective reduced
   integration (PSRI, Arnold & Brezzi 1997): with alpha = b^2/h^2 per cell (h the cell diameter)
 
       Pi_h = int psi_b dx_4 + alpha int (psi_m + psi_s) dx_4 + (1 - alpha) int (psi_m + psi_s) dx_2
 
-  (dx_k: Gauss rule exact to degree k; 6 and 3 points). The FEniCSx-Shells demo puts the bubble
-  on the displacement as here; the bubble keeps the reduced-integration part free of spurious
-  modes.
+  (dx_k: Gauss rule exact to degree k; 6 and 3 points; P3 uses degrees 6 and 4, 12 and 6
+  points). The FEniCSx-Shells demo puts the bubble on the displacement as here; the bubble keeps
+  the reduced-integration part free of spurious modes.
+* Observation: displacements are read at the nodes of the Lagrange space of the element's
+  degree (P2 or P3; exact there, the cubic bubble vanishing at every P2 node): positions, H_mid
+  at the centre vertex, the centerline y = 0, the symmetry defects.
 * Units: lengths in units of L (mesh x in [0, 1]) and the modulus scaled so that D = 1; energies
   in J are Pi * E b^3/12, forces in the project's unit E b^3 / L are the residual / 12, and the
   eigenvalues of K v = lambda M v with M = int u.v dA (displacement only, units of L) are
@@ -82,15 +86,13 @@ import ufl  # noqa: E402
 from dolfinx import fem  # noqa: E402
 from petsc4py import PETSc  # noqa: E402
 
+from .elements import ELEMENTS  # noqa: E402
 from .mesh import CLAMP_END, CLAMP_START, MeshSpec, create_mesh  # noqa: E402
 
 dolfinx.log.set_log_level(dolfinx.log.LogLevel.WARNING)
 
 #: Shear correction factor of the Reissner-Mindlin/Naghdi shear energy.
 SHEAR_FACTOR = 5.0 / 6.0
-
-#: Quadrature degrees of the full and the reduced PSRI rules (6 and 3 Gauss points).
-FULL_DEGREE, REDUCED_DEGREE = 4, 2
 
 EIGEN_NORMALISATION = ("lowest eigenvalue of the constrained tangent K v = lambda M v, "
                        "M = (1/W) int u.v dA over the displacement (rotations massless), times L^4/EI2")
@@ -149,16 +151,21 @@ class ShellParameters:
 
 
 class NaghdiStrip:
-    """The discrete Naghdi strip: spaces, energy, residual, tangent, clamps and observables."""
+    """The discrete Naghdi strip: spaces, energy, residual, tangent, clamps and observables, with
+    the finite element of spec.element (fem_reference.elements.ELEMENTS)."""
 
     def __init__(self, spec: MeshSpec, params: ShellParameters):
         self.spec, self.params = spec, params
+        self.shell_element = ELEMENTS[spec.element]
         self.mesh, self.facet_tags = create_mesh(spec)
         mesh = self.mesh
         cell = mesh.ufl_cell()
-        p2 = ufl.FiniteElement("Lagrange", cell, 2)
-        b3 = ufl.FiniteElement("Bubble", cell, 3)
-        self.element = ufl.MixedElement([ufl.VectorElement(p2 + b3, dim=3), ufl.VectorElement(p2, dim=2)])
+        e = self.shell_element
+        displacement = ufl.FiniteElement("Lagrange", cell, e.degree)
+        if e.bubble:
+            displacement = displacement + ufl.FiniteElement("Bubble", cell, e.bubble)
+        rotation = ufl.FiniteElement("Lagrange", cell, e.rotation_degree)
+        self.element = ufl.MixedElement([ufl.VectorElement(displacement, dim=3), ufl.VectorElement(rotation, dim=2)])
         self.V = fem.FunctionSpace(mesh, self.element)
         self.U, self.u_map = self.V.sub(0).collapse()
         self.T, self.theta_map = self.V.sub(1).collapse()
@@ -193,8 +200,8 @@ class NaghdiStrip:
         psi_m = 0.5 * t * quad(eps)
         psi_b = t**3 / 24.0 * (lam_b * ufl.tr(kappa) ** 2 + two_mu_b * ufl.inner(kappa, kappa))
         psi_s = 0.5 * t * SHEAR_FACTOR * mu * ufl.inner(gamma, gamma)
-        dx_f = ufl.Measure("dx", domain=mesh, metadata={"quadrature_degree": FULL_DEGREE})
-        dx_r = ufl.Measure("dx", domain=mesh, metadata={"quadrature_degree": REDUCED_DEGREE})
+        dx_f = ufl.Measure("dx", domain=mesh, metadata={"quadrature_degree": self.shell_element.full_degree})
+        dx_r = ufl.Measure("dx", domain=mesh, metadata={"quadrature_degree": self.shell_element.reduced_degree})
         h = ufl.CellDiameter(mesh)
         alpha_space = fem.FunctionSpace(mesh, ("DG", 0))
         self.alpha = fem.Function(alpha_space)
@@ -251,26 +258,27 @@ class NaghdiStrip:
         from scipy.spatial import cKDTree
 
         mesh = self.mesh
-        self.P2 = fem.VectorFunctionSpace(mesh, ("Lagrange", 2), dim=3)
+        # the nodes the displacement is read at: Lagrange of the element's degree (P2 or P3)
+        self.nodal = fem.VectorFunctionSpace(mesh, ("Lagrange", self.shell_element.degree), dim=3)
         self.P1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=3)
         self.P1_theta = fem.VectorFunctionSpace(mesh, ("Lagrange", 1), dim=2)
         u, theta = ufl.split(self.q)
-        self._u_expr = fem.Expression(u, self.P2.element.interpolation_points())
-        self.u2 = fem.Function(self.P2)
+        self._u_expr = fem.Expression(u, self.nodal.element.interpolation_points())
+        self.u_nodal = fem.Function(self.nodal)
         self.u1 = fem.Function(self.P1, name="displacement")
         self.theta1 = fem.Function(self.P1_theta, name="rotation")
         self._theta_expr = fem.Expression(theta, self.P1_theta.element.interpolation_points())
-        X = self.P2.tabulate_dof_coordinates()[:, :2]
+        X = self.nodal.tabulate_dof_coordinates()[:, :2]
         self.nodes_ref = X
         tree = cKDTree(X)
         dist, partner = tree.query(np.column_stack([1.0 - X[:, 0], -X[:, 1]]))
-        assert dist.max() < 1e-9, "P2 nodes are not half-turn symmetric"
+        assert dist.max() < 1e-9, "displacement nodes are not half-turn symmetric"
         self.partner = partner
         dist, mirror = tree.query(np.column_stack([X[:, 0], -X[:, 1]]))
         assert dist.max() < 1e-9
         self.mirror = mirror
         dist, centre = tree.query([0.5, 0.0])
-        assert dist < 1e-12, "no P2 node at the centre"
+        assert dist < 1e-12, "no displacement node at the centre"
         self.centre_node = int(centre)
         line = np.flatnonzero(np.abs(X[:, 1]) < 1e-12)
         self.centerline_nodes = line[np.argsort(X[line, 0])]
@@ -290,9 +298,10 @@ class NaghdiStrip:
         self.edges = np.unique(np.sort(edges, axis=1), axis=0)
 
     def displacement_nodes(self) -> np.ndarray:
-        """(n, 3) displacement at the P2 nodes (exact: the bubble vanishes on edges), units of L."""
-        self.u2.interpolate(self._u_expr)
-        return self.u2.x.array.reshape(-1, 3).copy()
+        """(n, 3) displacement at the nodes of self.nodal (P2: exact, the bubble vanishes on edges;
+        P3: the element's own nodes), units of L."""
+        self.u_nodal.interpolate(self._u_expr)
+        return self.u_nodal.x.array.reshape(-1, 3).copy()
 
     def positions(self) -> np.ndarray:
         u = self.displacement_nodes()
@@ -326,7 +335,7 @@ class NaghdiStrip:
     def resolution_indicators(self) -> dict:
         """max_turn_angle_deg: largest angle between the normals of neighbouring (P1) triangles;
         max_strain: largest relative change of length of a mesh edge (vertex positions)."""
-        self.u1.interpolate(self.u2)
+        self.u1.interpolate(self.u_nodal)
         x = np.column_stack([self.vertices_ref, np.zeros(len(self.vertices_ref))]) + self.u1.x.array.reshape(-1, 3)
         tri = x[self.cell_vertices]
         n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
@@ -339,7 +348,7 @@ class NaghdiStrip:
         return {"max_turn_angle_deg": float(angle.max()), "max_strain": float(np.abs(strain).max())}
 
     def update_output_fields(self) -> None:
-        self.u1.interpolate(self.u2)
+        self.u1.interpolate(self.u_nodal)
         self.theta1.interpolate(self._theta_expr)
 
     # --- state ------------------------------------------------------------------------------
@@ -353,7 +362,11 @@ class NaghdiStrip:
     def inextensible_guess(self, compression: float, amplitude_sign: float = 1.0) -> None:
         """First clamped buckling mode w = A (1 - cos 2 pi x) with A such that the centerline is
         inextensible and spans 1 - compression (x-displacement from dX/ds = sqrt(1 - w'^2)),
-        director tilted with the slope; u is L2-projected onto [P2 + B3]^3."""
+        director tilted with the slope; u is interpolated at the P2 nodes and L2-projected onto
+        [P2 + B3]^3, or interpolated in [P3]^3. (Forms assembled on the collapsed subspace
+        V.sub(0).collapse() of the mixed P3 space are wrong in dolfinx 0.5.2: an L2 projection
+        there missed the interpolated guess by 0.018 L at the nodes, 12 x 4 elements, while
+        interpolation into it and forms on the mixed space agree with a plain P3 space.)"""
         from scipy.integrate import cumulative_trapezoid
         from scipy.optimize import brentq
 
@@ -377,13 +390,17 @@ class NaghdiStrip:
         def theta_guess(x):
             return np.vstack([np.zeros(x.shape[1]), -np.arcsin(sign * A * k * np.sin(k * x[0]))])
 
-        u_p2 = fem.Function(self.P2)
-        u_p2.interpolate(u_guess)
-        u_proj = self._project(u_p2, self.U)
+        if self.shell_element.bubble:  # an enriched space has no nodal interpolation: project
+            u_nodes = fem.Function(self.nodal)
+            u_nodes.interpolate(u_guess)
+            u = self._project(u_nodes, self.U)
+        else:  # a Lagrange space: interpolate (see the docstring)
+            u = fem.Function(self.U)
+            u.interpolate(u_guess)
         theta = fem.Function(self.T)
         theta.interpolate(theta_guess)
         values = self.q.x.array.copy()
-        values[self.u_map] = u_proj.x.array
+        values[self.u_map] = u.x.array
         values[self.theta_map] = theta.x.array
         self.set_state(values)
 

@@ -14,7 +14,8 @@ from validation.reference import gold_name
 
 def study(model, compression, width, dw1, dw2, labels=("A", "B", "C")):
     """A hand-made study: dw1, dw2 are (value, error bar) or None."""
-    meshes = [MeshResult(label, 10 * (k + 1), "elements along L", None, None) for k, label in enumerate(labels)]
+    meshes = [MeshResult(label, 10 * (k + 1), "elements along L", dw1 and dw1[0], dw2 and dw2[0])
+              for k, label in enumerate(labels)]
     return Study(model, compression, width, meshes,
                  None if dw1 is None else Estimate(dw1[0], dw1[1], 1.5, True, "Richardson"),
                  None if dw2 is None else Estimate(dw2[0], dw2[1], None, False, "not asymptotic: the finest value"),
@@ -168,3 +169,14 @@ def test_on_the_committed_studies_the_narrow_half_compression_scene_has_fem_and_
     for model in ("fem", "plate"):
         assert row[f"{model}_dW1"] is not None and row[f"{model}_dW1_error_bar"] is not None
     assert row["dW1_in_error_bars"] is not None and row["paper_dW1"] == 0.36
+
+
+def test_the_meshes_column_names_the_meshes_a_value_rests_on():
+    """The finest three meshes that have the threshold (fem_reference.convergence.estimate): a
+    fourth mesh drops the coarsest, a mesh without the value (a run stopped short) is skipped."""
+    meshes = [MeshResult("N64x8", 64, "elements along L", 0.26, None), MeshResult("N96x12", 96, "", 0.262, 0.43),
+              MeshResult("N144x18", 144, "", 0.264, 0.431), MeshResult("N216x28", 216, "", 0.265, 0.4308)]
+    s = Study("fem", 0.5, 1 / 6, meshes, Estimate(0.265, 0.003), Estimate(0.4308, 0.01), None, "hand-made")
+    assert benchmark.basis_meshes(s, "dW1") == ["N96x12", "N144x18", "N216x28"]
+    meshes[2] = MeshResult("N144x18", 144, "", 0.264, None)
+    assert benchmark.basis_meshes(s, "dW2") == ["N96x12", "N216x28"]

@@ -1,6 +1,7 @@
 """The error map (issue 17 item 3): the error of every model at every resolution on every scene
 with a converged FEM reference, and its wall time:
-`python -m validation.error_map --out data/error_map [--only SCENE ...] [--models MODEL ...]`.
+`python -m validation.error_map --out data/error_map [--only SCENE ...] [--models MODEL ...]
+[--workers N | --scheduler ADDRESS] [--retries 2]`.
 
 Scenes: the ten of the benchmark (dL/L in {1/2, 1/4} x W/L in {1/20, 1/12, 1/6, 1/3, 1/2}, the
 paper's strip: L/b = 1181 at dL/L = 1/2, 787 at 1/4), each referenced by the FEM shell's mesh study
@@ -32,6 +33,13 @@ computed; a rerun keeps a row whose model, resolution and scene match with the s
 the stored ones) and the same reference hash (the reference study's files), and recomputes any
 other. Then OUT/README.md (the tables below it is computed from) and two figures (matplotlib,
 extra `plot`): OUT/speed_accuracy.png and OUT/enough_map.png.
+
+The runs made here are Dask tasks, as `python -m ddg sweep`'s (ddg.sweep.cluster): by default on a
+LocalCluster of one single-threaded worker process per core (--workers N), with --scheduler on an
+existing cluster (its workers need the same ddg sources: the rows carry the client's source hash).
+Each worker returns its row, the client writes it to the table as the run ends; the stored runs'
+rows are made by the client. A worker killed mid-run costs that run, which is retried (--retries);
+--timeout is checked at each Newton solve. Ctrl-C keeps every row written (exit 130).
 """
 from __future__ import annotations
 
@@ -40,7 +48,6 @@ import csv
 import hashlib
 import json
 import math
-import signal
 import sys
 import time
 from dataclasses import dataclass, field
@@ -50,7 +57,9 @@ import numpy as np
 
 from ddg.advise import (QUANTITIES, RULE_V1_MARGIN, at_scene, basis_scenes, choose, compared_at, cross_validated_margin,
                         fitting, map_scenes, parse_rows, scene_name)
-from ddg.output.io import StoredRun, atomic_write_text, finished_run_summary, finite_float, write_table_csv
+from ddg.output.io import (StoredRun, atomic_write_text, finished_run_summary, finite_float, save_figure,
+                          write_table_csv)
+from ddg.solve.probe import Probe
 
 from .claims import THRESHOLD_BAND
 from .benchmark import fraction_label
@@ -366,34 +375,43 @@ class _Timeout(Exception):
     pass
 
 
-def _alarm(signum, frame):
-    raise _Timeout(f"the run took more than {RUN_TIMEOUT} s")
+class _Deadline(Probe):
+    """A run's time limit, checked at each Newton solve and recorded step (in any thread: a Dask
+    worker runs its tasks outside the main thread, where SIGALRM cannot be used)."""
+
+    def __init__(self, seconds: float):
+        self.seconds, self.end = seconds, time.monotonic() + seconds
+
+    def solve(self, phase: str, iterations: int, converged: bool) -> None:
+        self._check()
+
+    def step(self, stage: str, row: dict, wall_s: float) -> None:
+        self._check()
+
+    def _check(self) -> None:
+        if time.monotonic() > self.end:
+            raise _Timeout(f"the run took more than {self.seconds:g} s")
 
 
 def run_row(scene: ReferenceScene, model: str, resolution: int, timeout: int = RUN_TIMEOUT) -> dict:
-    """One run made here (ddg.api.run_candidate, nothing written) and its row."""
+    """One run made here or in a Dask worker (ddg.api.run_candidate, nothing written) and its row;
+    stopped after `timeout` s (0: no limit)."""
     import ddg
     from ddg.api import run_candidate
 
     strip = ddg.Strip.from_ratios(scene.width_ratio, scene.compression_ratio, scene.slenderness)
     row = _base(scene, model, resolution, f"M{resolution}")
     row["run_source"] = "ddg.api.run_candidate"
-    previous = signal.signal(signal.SIGALRM, _alarm) if timeout else None
-    if timeout:
-        signal.alarm(int(timeout))
     t0 = time.perf_counter()
     try:
-        result = run_candidate(strip, ddg.LoadingProtocol(scene.compression_ratio), model, resolution)
-    except (_Timeout, Exception) as exc:  # noqa: BLE001  (a failing model is a row with its reason)
+        result = run_candidate(strip, ddg.LoadingProtocol(scene.compression_ratio), model, resolution,
+                               probe=_Deadline(timeout) if timeout else None)
+    except Exception as exc:  # noqa: BLE001  (a failing model, or one out of time, is a row with its reason)
         result = getattr(exc, "result", None)
         if result is None:
             row.update(status="error", wall_time_s=time.perf_counter() - t0,
                        reason=f"run failed: {type(exc).__name__}: {' '.join(str(exc).split())[:200]}")
             return row
-    finally:
-        if timeout:
-            signal.alarm(0)
-            signal.signal(signal.SIGALRM, previous)
     return _with_summary(row, scene, result.summary, result.rows)
 
 
@@ -405,13 +423,22 @@ def stored_row(scene: ReferenceScene, mesh: StoredMesh) -> dict:
     return _with_summary(row, scene, run.summary, run.rows)
 
 
-def build(out: Path, only=None, models=None, quiet: bool = False, timeout: int = RUN_TIMEOUT) -> list[dict]:
-    """Every row (module docstring) into OUT/error_map.csv, skipping current ones; the table's rows."""
+def build(out: Path, only=None, models=None, quiet: bool = False, timeout: int = RUN_TIMEOUT, *,
+          scheduler: str | None = None, workers: int | None = None, retries: int = 2) -> list[dict]:
+    """Every row (module docstring) into OUT/error_map.csv, skipping current ones; the table's rows.
+    The stored runs' rows are made here; the runs made here are Dask tasks (run_row on a worker,
+    ddg.sweep.cluster.run_all: `scheduler`, else a LocalCluster of `workers` processes), each row
+    written as its run ends. Ctrl-C: the rows written are kept, the interrupt is raised with a
+    `run_message`."""
+    from ddg.output.interrupts import signal_name_of
+    from ddg.sweep.cluster import Task, run_all
+
     from .runs import code_version
 
     table = Table(Path(out) / CSV_NAME)
     code = code_version()
     family = rod_family()
+    tasks = []
     for scene in reference_scenes():
         if only and scene.name not in only and (scene.folder_name or gold_name(scene.compression_ratio,
                                                                                scene.width_ratio)) not in only:
@@ -433,15 +460,30 @@ def build(out: Path, only=None, models=None, quiet: bool = False, timeout: int =
             if models and model not in models:
                 continue
             for m in resolutions:
-                if table.current((model, f"M{m}", scene.name), code, scene.reference_hash):
-                    continue
-                row = run_row(scene, model, m, timeout)
-                row["source_hash"] = code
-                table.put(row)
-                if not quiet:
-                    print(f"{scene.name} {model} M{m}: {row.get('status')}, {row.get('wall_time_s') or 0:.1f} s, "
-                          f"dW1 err {row.get('dW1_error')}, dW2 err {row.get('dW2_error')}, H_mid err "
-                          f"{row.get('H_mid_error')} {row.get('reason') or ''}", file=sys.stderr, flush=True)
+                if not table.current((model, f"M{m}", scene.name), code, scene.reference_hash):
+                    tasks.append(Task(f"error-map-{scene.name}-{model}-M{m}-{scene.reference_hash}-{code}", run_row,
+                                      (scene, model, m, timeout), m))
+
+    def finished(task, row, error):
+        scene, model, m, _ = task.args
+        if error is not None:  # the task itself failed (its worker died at every attempt): no row, rerun next time
+            print(f"error: {scene.name} {model} M{m}: {error}", file=sys.stderr, flush=True)
+            return
+        row["source_hash"] = code
+        table.put(row)
+        if not quiet:
+            print(f"{scene.name} {model} M{m}: {row.get('status')}, {row.get('wall_time_s') or 0:.1f} s, "
+                  f"dW1 err {row.get('dW1_error')}, dW2 err {row.get('dW2_error')}, H_mid err "
+                  f"{row.get('H_mid_error')} {row.get('reason') or ''}", file=sys.stderr, flush=True)
+
+    ran = run_all(tasks, finished, scheduler=scheduler, workers=workers, retries=retries, code=code)
+    if ran.interrupted is not None:
+        done = sum(table.current((t.args[1], f"M{t.args[2]}", t.args[0].name), code, t.args[0].reference_hash)
+                   for t in tasks)
+        ran.interrupted.run_message = (f"interrupted by {signal_name_of(ran.interrupted)}: {done} of {len(tasks)} "
+                                       f"runs finished and written to {table.path}; a rerun computes only the "
+                                       f"other {len(tasks) - done}")
+        raise ran.interrupted
     return table.rows
 
 
@@ -706,7 +748,7 @@ def figures(rows: list[dict], out: Path, tolerance: float = 0.01) -> list[str]:
     fig.text(0.01, 0.01, "the paper's L/b only; filled: dL/L = 1/2, open: 1/4; faint at 1: a quantity missing; dashed: "
              f"{tolerance:g}", fontsize=6)
     fig.tight_layout(rect=(0, 0.03, 1, 0.9))
-    fig.savefig(out / "speed_accuracy.png", dpi=90)
+    save_figure(fig, out / "speed_accuracy.png", dpi=90)
     plt.close(fig)
 
     names, first = _scene_order(rows)
@@ -734,7 +776,7 @@ def figures(rows: list[dict], out: Path, tolerance: float = 0.01) -> list[str]:
                          fontsize=7)
             ax.tick_params(labelsize=7)
     fig.tight_layout()
-    fig.savefig(out / "enough_map.png", dpi=90)
+    save_figure(fig, out / "enough_map.png", dpi=90)
     plt.close(fig)
     return ["speed_accuracy.png", "enough_map.png"]
 
@@ -780,7 +822,9 @@ def missing_scenes(scenes: list[ReferenceScene]) -> list[str]:
 
 def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
+    from ddg.output.interrupts import exit_code_of, terminate_as_interrupt
     from ddg.output.io import check_output_directory
+    from ddg.sweep import cluster
 
     parser = argparse.ArgumentParser(prog="python -m validation.error_map", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/error_map", help="output directory (default data/error_map)")
@@ -789,15 +833,27 @@ def main(argv=None) -> int:
     parser.add_argument("--models", nargs="+", default=None, help="models to (re)compute (default all)")
     parser.add_argument("--timeout", type=int, default=RUN_TIMEOUT, help="seconds per run made here")
     parser.add_argument("--report-only", action="store_true", help="no runs: README and figures from the CSV")
+    cluster.add_options(parser)  # --workers, --scheduler, --retries: the runs are Dask tasks, as the sweep's
     args = parser.parse_args(argv)
+    terminate_as_interrupt()  # SIGTERM too keeps the rows written
     try:
+        scheduler, workers, retries = cluster.checked_options(args.scheduler, args.workers, args.retries)
+        if not args.report_only:
+            scheduler = cluster.ready(scheduler, workers)
         out = check_output_directory(args.out, "--out")
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     scenes = reference_scenes()
-    rows = read_table(out / CSV_NAME) if args.report_only else build(out, args.only, args.models,
-                                                                     timeout=args.timeout)
+    try:
+        rows = read_table(out / CSV_NAME) if args.report_only else build(
+            out, args.only, args.models, timeout=args.timeout, scheduler=scheduler, workers=workers, retries=retries)
+    except InputError as exc:  # the scheduler at --scheduler does not answer
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt as exc:
+        print(f"error: {getattr(exc, 'run_message', 'interrupted')}", file=sys.stderr)
+        return exit_code_of(exc)
     if not rows:
         print("error: the map has no rows", file=sys.stderr)
         return 3

@@ -7,7 +7,6 @@ extra).
 """
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
@@ -570,14 +569,13 @@ def draw(data: FigureData):
 
 
 def save(fig, directory: Path, name: str) -> bytes:
-    """DIR/<name>.png (110 dpi) and .pdf; the figure is closed; returns the PNG bytes."""
+    """DIR/<name>.png (110 dpi) and .pdf, byte-stable (ddg.output.io.save_figure); the figure is
+    closed; returns the PNG bytes."""
+    from ddg.output.io import save_figure
+
     plt = _pyplot()
     directory = Path(directory)
-    directory.mkdir(parents=True, exist_ok=True)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    png = buf.getvalue()
-    (directory / f"{name}.png").write_bytes(png)
-    fig.savefig(directory / f"{name}.pdf", bbox_inches="tight")
+    png = save_figure(fig, directory / f"{name}.png", dpi=110, bbox_inches="tight").read_bytes()
+    save_figure(fig, directory / f"{name}.pdf", bbox_inches="tight")
     plt.close(fig)
     return png

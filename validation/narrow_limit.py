@@ -42,7 +42,8 @@ def run_fem(folder: Path, slenderness: float, along: int, across: int) -> dict |
         return done
     command = [sys.executable, "-m", "fem_reference", "simulate", "--width-ratio", repr(WIDTH_RATIO),
                "--compression-ratio", repr(COMPRESSION_RATIO), "--slenderness", repr(slenderness),
-               "--resolution", str(along), "--across", str(across), "--no-fields", "--quiet", "--out", str(folder)]
+               "--resolution", str(along), "--across", str(across), "--no-fields", "--no-centerline", "--quiet",
+               "--out", str(folder)]
     subprocess.run(command, check=False)
     return finished_run_summary(folder)
 
@@ -58,9 +59,11 @@ def run_ddg(folder: Path, model: str, slenderness: float, resolution: int) -> di
     protocol = ddg.LoadingProtocol(COMPRESSION_RATIO)
     if model == "plate":
         mesh = equilateral_mesh(strip.length, strip.width, resolution)
-        ddg.simulate(strip, protocol, model="plate", mesh=mesh, out=folder, branches=False, progress=False)
+        ddg.simulate(strip, protocol, model="plate", mesh=mesh, out=folder, branches=False, progress=False,
+                     centerline=False)
     else:
-        ddg.simulate(strip, protocol, model="rod", resolution=resolution, out=folder, branches=False, progress=False)
+        ddg.simulate(strip, protocol, model="rod", resolution=resolution, out=folder, branches=False, progress=False,
+                     centerline=False)
     return finished_run_summary(folder)
 
 

@@ -1,25 +1,35 @@
 """Mesh studies of the DDG plate on the benchmark scenes (issue 16 item 2):
 `python -m validation.plate_gold --out data/plate_gold [--only NAME ...] [--levels K]
-[--model plate|plate-midedge]` (the mid-edge plate on ghost-clamp meshes of the same rows, e.g. into
-data/midedge_gold).
+[--model plate|plate-midedge] [--workers N | --scheduler ADDRESS] [--retries 2]` (the mid-edge
+plate on ghost-clamp meshes of the same rows, e.g. into data/midedge_gold).
 
 Each of the ten scenes of fem_reference.gold (dL/L in {1/2, 1/4} x W/L in {1/20, 1/12, 1/6, 1/3,
-1/2}, L/b = 1181; with --only also the error map's scenes, fem_reference.gold.MAP_SCENES) is run with the plate on LEVELS exactly equilateral meshes
-(ddg.geometry.plate_mesh.equilateral_mesh) refined uniformly by 1.5: BASE_ROWS[W/L] rows of
-triangles across W, then 1.5 and 2.25 times as many (every spacing divided by 1.5 each time;
+1/2}, L/b = 1181; with --only also the error map's scenes, fem_reference.gold.MAP_SCENES) is run
+with the plate on LEVELS exactly equilateral meshes (ddg.geometry.plate_mesh.equilateral_mesh)
+refined uniformly by 1.5: BASE_ROWS[W/L] rows of triangles across W, then 1.5 and 2.25 times as
+many (every spacing divided by 1.5 each time;
 the default structured mesh cannot refine uniformly, its column count must stay odd). Each run
 is the README's path (40 compression and 120 shear steps to dW_max, thresholds located, no
-branch tracing) into OUT/<scene>/R<rows>/ (path.csv, summary.json, centerline.csv); after each
-run the scene's study is rewritten with the same estimates as the FEM gold
+branch tracing) into OUT/<scene>/R<rows>/ (path.csv, summary.json; no centerline.csv, which no
+study reads); after each run the scene's study is rewritten with the same estimates as the FEM gold
 (fem_reference.convergence.study_estimates: Richardson with the observed order and a grid
 convergence index where asymptotic, else the finest value with its spread, flagged):
 OUT/<scene>/richardson.json and convergence.md, then OUT/index.json and OUT/README.md.
 Resumable run by run (a finished run on the same mesh is kept).
+
+The runs are Dask tasks, as `python -m ddg sweep`'s (ddg.sweep.cluster): by default on a
+LocalCluster of one single-threaded worker process per core (--workers N), with --scheduler on an
+existing cluster whose workers share OUT and the checkout; each worker writes its run's folder,
+the client rewrites the studies and the index as each run ends. A worker killed mid-run costs that
+run, which is retried (--retries); Ctrl-C keeps every finished run (exit 130). Exit 3 if a run
+stopped short, 1 if one failed (one line each on stderr).
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -59,27 +69,48 @@ def model_mesh(model: str, length: float, width: float, rows: int):
     return equilateral_mesh(length, width, rows)
 
 
-def run_scene(out: Path, name: str, compression: float, width: float, levels: int, quiet: bool,
-              model: str = "plate", slenderness: float | None = None) -> int:
+def run_mesh(name: str, compression: float, width: float, slenderness: float | None, rows: int, model: str,
+             target: str) -> dict:
+    """One run of a study, in a Dask worker: `model` on `rows` rows of triangles across W into
+    `target` (path.csv, summary.json). Returns its triangles, status, dW1_over_L, dW2_over_L,
+    converged and wall_time_s; a run an earlier attempt finished is returned as stored, a run
+    that raised gives {"error": one line} (not retried: it would fail again)."""
     import ddg
 
-    status = 0
-    for rows in rows_sequence(width, levels):
-        target = out / name / f"R{rows}"
-        if _finished(target):
-            continue
+    t0 = time.perf_counter()
+    summary = finished_run_summary(target)
+    if summary is None:
         strip = ddg.Strip.from_ratios(width, compression, slenderness)
-        t0 = time.perf_counter()
-        result = ddg.simulate(strip, ddg.LoadingProtocol(compression), model=model,
-                              mesh=model_mesh(model, strip.length, strip.width, rows), out=target, branches=False)
-        if not quiet:
-            s = result.summary
-            print(f"{name} R{rows} ({s['mesh']['triangles']} triangles): {s['status']}, "
-                  f"{time.perf_counter() - t0:.0f} s, dW1/L {s['dW1_over_L']}, dW2/L {s['dW2_over_L']}", flush=True)
-        status = status or (0 if result.converged else 3)
-        write_scene_study(out / name, rows_sequence(width, levels), model)
-        write_index(out, model)
-    return status
+        try:
+            summary = ddg.simulate(strip, ddg.LoadingProtocol(compression), model=model,
+                                   mesh=model_mesh(model, strip.length, strip.width, rows), out=target,
+                                   branches=False, centerline=False).summary
+        except Exception as exc:  # noqa: BLE001  (reported by the client, one line)
+            return {"error": f"{type(exc).__name__}: {' '.join(str(exc).split())}",
+                    "wall_time_s": time.perf_counter() - t0}
+    return {"triangles": (summary.get("mesh") or {}).get("triangles"),
+            **{k: summary.get(k) for k in ("status", "dW1_over_L", "dW2_over_L")},
+            "converged": bool(summary.get("converged")), "wall_time_s": time.perf_counter() - t0}
+
+
+def study_tasks(out: Path, selected, levels: int, model: str) -> list:
+    """The unfinished runs of the selected scenes ((name, dL/L, W/L, L/b)) as Dask tasks
+    (ddg.sweep.cluster.Task, tagged (name, rows, sequence)), the largest meshes first (a priority
+    proportional to the triangle count: the workers end together)."""
+    from ddg.sweep.cluster import Task
+
+    root = Path(out).resolve()
+    where = hashlib.sha256(str(root).encode()).hexdigest()[:8]
+    tasks = []
+    for name, compression, width, slenderness in selected:
+        sequence = rows_sequence(width, levels)
+        for rows in sequence:
+            target = root / name / f"R{rows}"
+            if not _finished(target):
+                tasks.append(Task(f"plate-gold-{model}-{name}-R{rows}-{where}", run_mesh,
+                                  (name, compression, width, slenderness, rows, model, str(target)),
+                                  int(rows * rows / width), (name, rows, sequence)))
+    return tasks
 
 
 def write_scene_study(folder: Path, sequence: list[int], model: str = "plate") -> dict | None:
@@ -158,7 +189,10 @@ def write_index(out: Path, model: str = "plate") -> None:
 
 def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
+    from ddg.output.interrupts import deferred_signals, exit_code_of, signal_name_of, terminate_as_interrupt
     from ddg.output.io import check_output_directory
+    from ddg.sweep import cluster
+    from ddg.sweep.grid import code_version
     from fem_reference.gold import all_scenes, scenes
 
     parser = argparse.ArgumentParser(prog="python -m validation.plate_gold", description=__doc__.split("\n")[0])
@@ -169,7 +203,9 @@ def main(argv=None) -> int:
     parser.add_argument("--model", choices=sorted(MODELS), default="plate")
     parser.add_argument("--studies-only", action="store_true",
                         help="no run: rewrite each selected scene's study and the index from its finished runs")
+    cluster.add_options(parser)  # --workers, --scheduler, --retries: the runs are Dask tasks, as the sweep's
     args = parser.parse_args(argv)
+    terminate_as_interrupt()  # SIGTERM too keeps the finished runs
     known = [name for name, _, _, _ in all_scenes()]
     paper = {name for name, _, _ in scenes()}
     try:
@@ -178,22 +214,58 @@ def main(argv=None) -> int:
             raise InputError(f"--only: unknown scene(s) {unknown}; choose from {', '.join(known)}")
         if not 1 <= args.levels <= 4:
             raise InputError(f"--levels = {args.levels} outside 1..4")
+        scheduler, workers, retries = cluster.checked_options(args.scheduler, args.workers, args.retries)
+        if not args.studies_only:
+            scheduler = cluster.ready(scheduler, workers)
         out = check_output_directory(args.out, "--out")
     except InputError as exc:
-        print(f"error: {exc}")
+        print(f"error: {exc}", file=sys.stderr)
         return 2
-    status = 0
-    for name, compression, width, slenderness in all_scenes():
-        if (args.only and name not in args.only) or (not args.only and name not in paper):
-            continue  # the error map's scenes (fem_reference.gold.MAP_SCENES) run only when named
-        if args.studies_only:
+    # the error map's scenes (fem_reference.gold.MAP_SCENES) run only when named
+    selected = [(name, compression, width, slenderness) for name, compression, width, slenderness in all_scenes()
+                if (name in args.only if args.only else name in paper)]
+    if args.studies_only:
+        for name, _, width, _ in selected:
             if (out / name).is_dir():
                 write_scene_study(out / name, rows_sequence(width, args.levels), args.model)
-            continue
-        status = run_scene(out, name, compression, width, args.levels, args.quiet, args.model,
-                           slenderness) or status
-    write_index(out, args.model)
-    return status
+        write_index(out, args.model)
+        return 0
+    tasks = study_tasks(out, selected, args.levels, args.model)
+    failed, stopped = [], []
+
+    def finished(task, result, error):
+        name, rows, sequence = task.tag
+        error = error or (result or {}).get("error")
+        if error is not None:
+            failed.append(task)
+            print(f"error: {name} R{rows}: {error}", file=sys.stderr, flush=True)
+        else:
+            if not args.quiet:
+                print(f"{name} R{rows} ({result['triangles']} triangles): {result['status']}, "
+                      f"{result['wall_time_s']:.0f} s, dW1/L {result['dW1_over_L']}, dW2/L {result['dW2_over_L']}",
+                      flush=True)
+            if not result["converged"]:
+                stopped.append(task)
+        write_scene_study(out / name, sequence, args.model)
+        write_index(out, args.model)
+
+    try:
+        ran = cluster.run_all(tasks, finished, scheduler=scheduler, workers=workers, retries=retries,
+                              code=code_version(), shared=out)
+    except InputError as exc:  # the scheduler at --scheduler does not answer
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    with deferred_signals():  # the index lists what is finished, also after Ctrl-C
+        if ran.interrupted is not None:  # runs that ended while the client was stopping
+            for name, sequence in {t.tag[0]: t.tag[2] for t in tasks}.items():
+                write_scene_study(out / name, sequence, args.model)
+        write_index(out, args.model)
+    if ran.interrupted is not None:
+        done = sum(_finished(Path(t.args[6])) for t in tasks)
+        print(f"error: interrupted by {signal_name_of(ran.interrupted)}: {done} of {len(tasks)} runs finished and "
+              f"kept in {out}; a rerun computes only the other {len(tasks) - done}", file=sys.stderr)
+        return exit_code_of(ran.interrupted)
+    return 1 if failed else 3 if stopped else 0
 
 
 if __name__ == "__main__":

@@ -1,4 +1,5 @@
-"""The output contract: DIR/path.csv and DIR/summary.json, written atomically."""
+"""The output contract: DIR/path.csv and DIR/summary.json, written atomically; figures saved
+byte-stable (save_figure)."""
 from __future__ import annotations
 
 import contextlib
@@ -43,6 +44,42 @@ def atomic_write_text(path: Path, text: str) -> None:
     with atomic_path(path) as tmp:
         with open(tmp, "w", newline="") as fh:
             fh.write(text)
+
+
+#: What matplotlib stamps into a saved figure besides the drawing (the date, its own name and
+#: version), per format; None leaves the key out, so the same figure gives the same bytes on
+#: every regeneration, with or without SOURCE_DATE_EPOCH.
+FIGURE_METADATA = {"png": {"Software": None},
+                   "pdf": {"CreationDate": None, "Creator": None, "Producer": None},
+                   "svg": {"Date": None, "Creator": None}}
+#: Salt of the SVG element ids (matplotlib's default, svg.hashsalt None, is a fresh random one per save).
+SVG_HASH_SALT = "ddg-strips"
+
+
+def figure_bytes(fig, fmt: str = "png", **options) -> bytes:
+    """A matplotlib figure as PNG, PDF or SVG bytes without date or software stamps
+    (FIGURE_METADATA) and with fixed SVG ids: byte-identical for the same drawing. `options` go
+    to savefig (dpi, bbox_inches, ...)."""
+    import matplotlib
+
+    fmt = str(fmt).lower()
+    if fmt not in FIGURE_METADATA:
+        raise ValueError(f"figure format {fmt!r} is not one of {', '.join(FIGURE_METADATA)}")
+    buf = io.BytesIO()
+    with matplotlib.rc_context({"svg.hashsalt": SVG_HASH_SALT}):
+        fig.savefig(buf, format=fmt, metadata=FIGURE_METADATA[fmt], **options)
+    return buf.getvalue()
+
+
+def save_figure(fig, path, **options) -> Path:
+    """Save a matplotlib figure to `path` (format from the suffix: .png, .pdf or .svg), atomically
+    and byte-stable (figure_bytes): the one place the project saves figures."""
+    path = Path(path)
+    data = figure_bytes(fig, path.suffix.lstrip("."), **options)
+    with atomic_path(path, suffix=path.suffix) as tmp:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+    return path
 
 
 def write_table_csv(path: Path, rows: list[dict], fieldnames: list[str] | None = None) -> None:

@@ -6,6 +6,7 @@ resume after an interruption or a lost worker with only the unfinished runs.
 """
 from __future__ import annotations
 
+import hashlib
 import sys
 import time
 import uuid
@@ -13,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .grid import RunSpec, code_version, estimated_cost
-from .tasks import RunResult, execute_one, is_finished, load, materialise
+from .tasks import RunResult, execute_one, is_finished, load, materialise, run_task
 
 
 class Progress:
@@ -99,21 +100,32 @@ def run_cached(specs: list[RunSpec], root, task=None, *, workers: int | None = N
             for spec, directory in todo:
                 finished(spec, directory, task(spec, str(directory)))
         elif todo:
-            from .cluster import connect, describe, submit_runs
+            from .cluster import Task, run_all
 
             root.mkdir(parents=True, exist_ok=True)
+            # the run's own probe: a worker that does not see ROOT runs in a temporary folder and
+            # sends the files back (ddg.sweep.tasks.run_task), instead of refusing the run
             probe = root / f".probe-{uuid.uuid4().hex}"
             token = uuid.uuid4().hex
             probe.write_text(token)
+            tasks = [Task(f"ddg-run-{directory.name}-{hashlib.sha256(str(directory).encode()).hexdigest()[:8]}",
+                          run_task, (task, spec, str(directory), (str(probe), token), code),
+                          int(100 * estimated_cost(spec)), (spec, directory)) for spec, directory in todo]
+
+            def filed(job, record, error):
+                spec, directory = job.tag
+                if error is not None:
+                    record = {"error": error, "report_wall_time_s": None}
+                materialise(record, directory)
+                finished(spec, directory, record)
+
             try:
-                with connect(scheduler, workers, retries) as client:
-                    outcome.where = describe(client)
-                    for spec, directory, record in submit_runs(client, todo, task, retries, code,
-                                                                (str(probe), token)):
-                        materialise(record, directory)
-                        finished(spec, directory, record)
+                ran = run_all(tasks, filed, scheduler=scheduler, workers=workers, retries=retries)
             finally:
                 probe.unlink(missing_ok=True)
+            outcome.where = ran.where
+            if ran.interrupted is not None:
+                raise ran.interrupted
     except KeyboardInterrupt as exc:
         outcome.interrupted = exc
         for spec, directory in todo:  # finished in a worker while the client was being stopped

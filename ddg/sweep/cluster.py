@@ -1,18 +1,25 @@
-"""The Dask side of a sweep: a client on a LocalCluster (default) or on an existing scheduler,
-and the runs submitted to it as futures with retries.
+"""The Dask side of a sweep and of the mesh-study generators: a client on a LocalCluster (default)
+or on an existing scheduler, keyed tasks submitted to it as futures with retries, and the
+command-line options that choose the cluster (--workers, --scheduler, --retries).
 
 The only module of ddg that imports dask (lazily): `require_dask()` turns a missing install
 into a one-line InputError naming the extra. A LocalCluster has one single-threaded worker
 process per core; its scheduler gives a task whose worker dies `retries` more attempts
 (distributed.scheduler.allowed-failures), and `retries` also re-runs a task that raised. An
-existing scheduler keeps its own allowed-failures (3 by default).
+existing scheduler keeps its own allowed-failures (3 by default). `run_all` is the loop every
+command shares: submit the tasks, call back on the client as each one finishes, keep what
+finished on Ctrl-C.
 """
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import logging
 import os
+import socket
+import uuid
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
 
 from ..geometry.strip import InputError
 
@@ -97,35 +104,167 @@ def describe(client) -> str:
     return f"the scheduler at {client.scheduler.address} ({workers} worker{'s' * (workers != 1)})"
 
 
-def submit_runs(client, todo, task, retries: int, code: str, probe=None):
-    """Submit each (spec, directory) as ddg.sweep.tasks.run_task(task, spec, directory, probe, code),
-    the costliest first; yields (spec, directory, record) as they finish. A task that still fails
-    after its retries, or whose workers died too often, gives a record with its error."""
+@dataclass(frozen=True)
+class Task:
+    """One unit of work: `function(*args)` on a worker under the Dask `key` (unique per result:
+    the same key in two submissions is one computation), the higher `priority` first; `tag` stays
+    on the client (what the caller needs to file the result)."""
+
+    key: str
+    function: Callable
+    args: tuple = ()
+    priority: int = 0
+    tag: Any = None
+
+
+@dataclass
+class Ran:
+    """What run_all did: `where` the tasks ran ("" if there were none), `interrupted` the
+    KeyboardInterrupt (or SIGTERM's RunInterrupted) that stopped it, None if it ran to the end."""
+
+    where: str = ""
+    interrupted: BaseException | None = None
+
+
+class WorkerMismatch(RuntimeError):
+    """A worker that must not run the task: other ddg sources, or it does not see the output folder."""
+
+
+def run_all(tasks: list[Task], finished: Callable, *, scheduler: str | None = None, workers: int | None = None,
+            retries: int = 2, code: str | None = None, shared=None) -> Ran:
+    """Every task on Dask (`scheduler`, else a new LocalCluster of `workers` processes; none is
+    started without tasks), `finished(task, result, error)` called here as each one ends: its
+    result and None, or None and a one-line error for a task that still failed after its retries.
+
+    With `code` (ddg.sweep.grid.code_version() here) a worker with other ddg sources refuses the
+    tasks; with `shared` (a folder the tasks write into) a worker that does not see it refuses them
+    (its files would land on its own disk): a probe file lies in `shared` while the tasks run.
+    Ctrl-C stops it: the tasks not finished are cancelled, the interrupt is in Ran.interrupted;
+    what `finished` has filed stays."""
+    ran = Ran()
+    if not tasks:
+        return ran
+    probe = None
+    try:
+        if shared is not None:
+            probe = (str(Path(shared).resolve() / f".probe-{uuid.uuid4().hex}"), uuid.uuid4().hex)
+            Path(probe[0]).write_text(probe[1])
+        with connect(scheduler, workers, retries) as client:
+            ran.where = describe(client)
+            for task, result, error in run_tasks(client, tasks, retries, code, probe):
+                finished(task, result, error)
+    except KeyboardInterrupt as exc:
+        ran.interrupted = exc
+    finally:
+        if probe is not None:
+            Path(probe[0]).unlink(missing_ok=True)
+    return ran
+
+
+def run_tasks(client, tasks: list[Task], retries: int, code: str | None = None, probe: tuple[str, str] | None = None):
+    """Submit every task as a CheckedCall (code and probe as in run_all); yields (task,
+    result, None), or (task, None, error) for a task that still fails after its retries or whose
+    workers died too often, as they finish. The tasks not finished when the caller stops
+    (Ctrl-C, or it closes the generator) are cancelled."""
     from distributed import as_completed
 
-    from .grid import estimated_cost
-    from .tasks import run_task
-
     futures = {}
-    for spec, directory in todo:
-        where = hashlib.sha256(str(directory).encode()).hexdigest()[:8]
-        future = client.submit(run_task, task, spec, str(directory), probe, code,
-                               key=f"ddg-run-{directory.name}-{where}", retries=retries,
-                               priority=int(100 * estimated_cost(spec)))
-        futures[future] = (spec, directory)
+    for task in tasks:
+        future = client.submit(CheckedCall(task.function, task.args, code, probe), key=task.key, retries=retries,
+                                priority=task.priority)
+        futures[future] = task
     try:
         for future in as_completed(list(futures)):
-            spec, directory = futures.pop(future)
+            task = futures.pop(future)
             try:
-                record = future.result()
+                result, error = future.result(), None
             except Exception as exc:  # noqa: BLE001  (KilledWorker, CancelledError, the task's own error)
-                record = {"error": _task_error(exc, retries), "report_wall_time_s": None}
+                result, error = None, _task_error(exc, retries)
             finally:
                 future.release()
-            yield spec, directory, record
+            yield task, result, error
     finally:
-        if futures:  # interrupted (or the caller stopped): the runs not finished are dropped
+        if futures:  # interrupted (or the caller stopped): the tasks not finished are dropped
             client.cancel(list(futures), force=True)
+
+
+class CheckedCall:
+    """`function(*args)` in a worker, after the checks of run_all: WorkerMismatch (retried, perhaps
+    on another worker) if this worker's ddg sources differ from `code` or it cannot read the
+    client's `probe` file (path, content). An object, not a tuple of arguments: Dask would run a
+    tuple that begins with a callable (the sweep's task function) as a task of its own."""
+
+    def __init__(self, function: Callable, args: tuple, code: str | None = None,
+                 probe: tuple[str, str] | None = None):
+        self.function, self.args, self.code, self.probe = function, args, code, probe
+
+    def __call__(self):
+        if self.code is not None:
+            from .grid import code_version
+
+            mine = code_version()
+            if mine != self.code:
+                raise WorkerMismatch(f"the worker on {socket.gethostname()} runs other ddg sources (code {mine}, "
+                                     f"the client's {self.code}); install the same code on every worker")
+        if self.probe is not None:
+            try:
+                seen = Path(self.probe[0]).read_text() == self.probe[1]
+            except OSError:
+                seen = False
+            if not seen:
+                raise WorkerMismatch(f"the worker on {socket.gethostname()} does not see the output folder "
+                                     f"{Path(self.probe[0]).parent}; run workers that share it")
+        return self.function(*self.args)
+
+
+# ---------------------------------------------------------------------------- command-line options
+def add_options(parser) -> None:
+    """--workers, --scheduler and --retries (values read as text: checked_options gives the one-line errors)."""
+    parser.add_argument("--workers", default=None, metavar="N",
+                        help="worker processes of the LocalCluster (default: the cores; one run each at a time)")
+    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                        help="an existing Dask scheduler, e.g. tcp://host:8786 (dask-scheduler / dask-worker, "
+                             "dask-jobqueue); default: DASK_SCHEDULER_ADDRESS if set, else a LocalCluster")
+    parser.add_argument("--retries", default=2, metavar="N",
+                        help="more attempts of a run whose worker died or that raised (default 2; an existing "
+                             "scheduler's own allowed-failures applies to worker deaths)")
+
+
+def checked_options(scheduler, workers, retries) -> tuple[str | None, int | None, int]:
+    """(scheduler, workers, retries) of add_options' values, each checked (a one-line InputError
+    naming the option), dask not imported."""
+    from ..limits import check_integer
+
+    retries = check_integer("--retries", _integer("--retries", retries), 0, MAX_RETRIES)
+    if scheduler is not None:
+        if not isinstance(scheduler, str) or not scheduler.strip() or any(c.isspace() for c in scheduler):
+            raise InputError(f"--scheduler {scheduler!r} is not an address; give e.g. tcp://host:8786")
+        if workers is not None:
+            raise InputError("--workers applies to the LocalCluster only; the cluster at --scheduler has its own "
+                             "workers")
+    if workers is not None:
+        most = max(4 * cores(), 8)
+        workers = check_integer("--workers", _integer("--workers", workers), 1, most,
+                                "each worker is a process running one run at a time; more than the cores share them")
+    return scheduler, workers, retries
+
+
+def ready(scheduler: str | None, workers: int | None) -> str | None:
+    """require_dask(), then the scheduler to use: `scheduler`, else Dask's own setting
+    (DASK_SCHEDULER_ADDRESS) unless --workers asked for a LocalCluster, else None (a LocalCluster)."""
+    require_dask()
+    if scheduler is None and workers is None:
+        return default_scheduler()
+    return scheduler
+
+
+def _integer(name: str, value):
+    if isinstance(value, str):
+        try:
+            return int(value.strip())
+        except ValueError:
+            raise InputError(f"{name} {value!r} is not an integer") from None
+    return value
 
 
 def _task_error(exc: BaseException, retries: int) -> str:

@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from ..geometry.strip import InputError
+from . import cluster
 
 #: The paper's widths (the FEM gold scenes): W/L = 1/20, 1/12, 1/6, 1/3, 1/2.
 DEFAULT_WIDTHS = "0.05,0.08333333333333333,0.16666666666666666,0.3333333333333333,0.5"
@@ -38,23 +39,14 @@ def add_arguments(parser) -> None:
     parser.add_argument("--shear-steps", type=int, default=120, help="recorded shear steps (default 120)")
     parser.add_argument("--out", default="out/sweep",
                         help="output directory: runs/<key>/, sweep.csv, phase_diagram.png/.pdf (default out/sweep)")
-    parser.add_argument("--workers", type=int, default=None,
-                        help="worker processes of the LocalCluster (default: the cores; one run each at a time)")
-    parser.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                        help="an existing Dask scheduler, e.g. tcp://host:8786 (dask-scheduler / dask-worker, "
-                             "dask-jobqueue); default: DASK_SCHEDULER_ADDRESS if set, else a LocalCluster")
-    parser.add_argument("--retries", type=int, default=2,
-                        help="more attempts of a run whose worker died or that raised (default 2; an existing "
-                             "scheduler's own allowed-failures applies to worker deaths)")
+    cluster.add_options(parser)
     parser.add_argument("--quiet", action="store_true", help="no progress bar or summary line")
 
 
 def main(args) -> int:
     """Run the sweep; returns the exit code."""
-    from ..limits import check_integer
     from ..output.interrupts import deferred_signals, exit_code_of, signal_name_of
     from ..output.io import check_output_directory
-    from . import cluster
     from .cache import run_cached
     from .grid import grid
     from .table import sweep_rows, write_table
@@ -64,22 +56,8 @@ def main(args) -> int:
                  [None] if args.slenderness is None else _floats("--slenderness L/b", args.slenderness, float("inf")),
                  [None] if args.resolutions is None else _integers("--resolutions", args.resolutions),
                  args.compression_steps, args.shear_steps)
-    retries = check_integer("--retries", args.retries, 0, cluster.MAX_RETRIES)
-    scheduler = args.scheduler
-    if scheduler is not None:
-        if not scheduler.strip() or any(c.isspace() for c in scheduler):
-            raise InputError(f"--scheduler {scheduler!r} is not an address; give e.g. tcp://host:8786")
-        if args.workers is not None:
-            raise InputError("--workers applies to the LocalCluster only; the cluster at --scheduler has its own "
-                             "workers")
-    workers = None
-    if args.workers is not None:
-        most = max(4 * cluster.cores(), 8)
-        workers = check_integer("--workers", args.workers, 1, most,
-                                "each worker is a process running one run at a time; more than the cores share them")
-    cluster.require_dask()
-    if scheduler is None and workers is None:
-        scheduler = cluster.default_scheduler()
+    scheduler, workers, retries = cluster.checked_options(args.scheduler, args.workers, args.retries)
+    scheduler = cluster.ready(scheduler, workers)
     out = check_output_directory(args.out, "--out")
 
     outcome = run_cached(specs, out / "runs", workers=workers, scheduler=scheduler, retries=retries,

@@ -1,78 +1,82 @@
 """The sweep's phase diagram in the manner of the paper's Fig. 8: dW1/L and dW2/L against W/L, one
-panel per dL/L, one curve per model (and L/b, resolution), with the FEM shell's gold thresholds
-and their error bars where a mesh-convergence estimate exists (data/fem_gold, data/fem_convergence).
+panel per dL/L, one curve per model (and L/b, resolution), with the FEM shell's gold thresholds:
+per scene the converged value of its mesh study and its error bar (data/fem_gold/index.json,
+written by `python -m fem_reference gold`; read as a file, so ddg imports nothing of fem_reference).
 
 matplotlib is optional (the 'plot' extra); `write_phase_diagram` raises ImportError without it.
 """
 from __future__ import annotations
 
-import csv
-import json
 import math
 import textwrap
 from pathlib import Path
 
 from ..geometry.strip import shear_limit
-from ..output.io import finite_float
+from ..output.io import finite_float, read_json_object, save_figure
 
-#: The repository's data folder (gold data and its convergence studies); absent in an installed wheel.
+#: The repository's data folder (the FEM gold index and its studies); absent in an installed wheel.
 DATA = Path(__file__).resolve().parents[2] / "data"
 
 PHASE_COLOURS = {"U": "#dbe9f6", "US": "#fde6cf", "S": "#dff2de"}
 
 
 def gold_thresholds(data: Path = DATA) -> list[dict]:
-    """The FEM gold scenes of the paper's strip (data/fem_gold/index.json) that converged: dL/L,
-    W/L, dW1/L, dW2/L, the mesh (elements along L) and the errors `dW1_error`, `dW2_error` estimated by the
-    Richardson extrapolation of data/fem_convergence/<scene>[_full]/thresholds.csv at that mesh
-    (None where no study exists: no error bar)."""
-    index = Path(data) / "fem_gold" / "index.json"
-    if not index.exists():
-        return []
+    """The FEM gold thresholds of the paper's strip (L/b = 1181) per scene of
+    DATA/fem_gold/index.json: dL/L, W/L, dW1/L, dW2/L and their error bars dW1_error, dW2_error.
+
+    A scene with a mesh study (its entry's "study": "dW1" and "dW2", each {"value", "error_bar"},
+    fem_reference.convergence.estimate: Richardson extrapolation or the finest mesh, with its error
+    bar) gives the study's converged values and error bars, `meshes` its meshes and `basis`
+    "study"; a scene without one, the finished finest run's thresholds with no error bar (None)
+    and `basis` "single run". Scenes of another strip (the error map's, "slenderness" set) are
+    left out. [] without the index."""
+    index = read_json_object(Path(data) / "fem_gold" / "index.json")
     out = []
-    for scene, entry in sorted(json.loads(index.read_text()).items()):
-        if not entry.get("converged") or entry.get("slenderness") is not None:
-            continue  # unfinished, or a strip other than the paper's (the error map's scenes)
-        errors = _convergence_errors(Path(data) / "fem_convergence", scene, entry.get("resolution"))
-        out.append({"scene": scene, "dL_over_L": entry["compression_ratio"], "W_over_L": entry["width_ratio"],
-                    "resolution": entry.get("resolution"), "dW1_over_L": entry.get("dW1_over_L"),
-                    "dW2_over_L": entry.get("dW2_over_L"), "dW1_error": errors.get("dW1_error"),
-                    "dW2_error": errors.get("dW2_error")})
+    for scene, entry in sorted((index or {}).items()):
+        if not isinstance(entry, dict) or entry.get("slenderness") is not None:
+            continue  # a strip other than the paper's (the error map's scenes)
+        study = entry.get("study") if isinstance(entry.get("study"), dict) else {}
+        point = {"scene": scene, "dL_over_L": entry.get("compression_ratio"), "W_over_L": entry.get("width_ratio"),
+                 "meshes": study.get("meshes")}
+        for key in ("dW1", "dW2"):
+            estimate = study.get(key) if isinstance(study.get(key), dict) else {}
+            value = finite_float(estimate.get("value"))
+            point[f"{key}_over_L"] = value
+            point[f"{key}_error"] = finite_float(estimate.get("error_bar")) if value is not None else None
+        point["basis"] = "study"
+        if point["dW1_over_L"] is None and point["dW2_over_L"] is None:
+            if not entry.get("converged"):
+                continue  # no study and no finished run
+            point.update(dW1_over_L=finite_float(entry.get("dW1_over_L")),
+                         dW2_over_L=finite_float(entry.get("dW2_over_L")),
+                         dW1_error=None, dW2_error=None, basis="single run", meshes=None)
+        if finite_float(point["dL_over_L"]) is None or finite_float(point["W_over_L"]) is None:
+            continue
+        if point["dW1_over_L"] is not None or point["dW2_over_L"] is not None:
+            out.append(point)
     return out
 
 
-def _convergence_errors(root: Path, scene: str, resolution) -> dict:
-    """dW1_error and dW2_error of the study's row at `resolution`; the whole-path study (_full)
-    first, then the dW1-only one."""
-    found: dict = {}
-    for folder in (root / f"{scene}_full", root / scene):
-        path = folder / "thresholds.csv"
-        if not path.exists() or resolution is None:
-            continue
-        with open(path, newline="") as fh:
-            for row in csv.DictReader(fh):
-                if row.get("resolution") != str(resolution):
-                    continue
-                for key in ("dW1_error", "dW2_error"):
-                    value = finite_float(row.get(key))
-                    if key not in found and value is not None:
-                        found[key] = value
-    return found
-
-
 def write_phase_diagram(out, rows: list[dict], data: Path = DATA) -> tuple[list[Path], str]:
-    """DIR/phase_diagram.png and .pdf from the table rows; returns the paths and the caption
-    (also printed under the figure)."""
+    """DIR/phase_diagram.png and .pdf from the table rows, with the FEM gold thresholds of
+    `data` (gold_thresholds); returns the paths and the caption (also printed under the figure)."""
+    fig, caption = phase_diagram_figure(rows, gold_thresholds(data))
+    out = Path(out)
+    written = [save_figure(fig, out / f"phase_diagram.{suffix}", dpi=150) for suffix in ("png", "pdf")]
+    return written, caption
+
+
+def phase_diagram_figure(rows: list[dict], gold: list[dict]):
+    """The phase diagram (a matplotlib Figure, no pyplot state) of the table rows and the gold
+    thresholds (gold_thresholds), and its caption."""
     import importlib
 
     importlib.import_module("matplotlib")  # ImportError without the 'plot' extra, before any work
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    out = Path(out)
     usable = [r for r in rows if r.get("dW1_over_L") is not None or r.get("dW2_over_L") is not None]
     panels = sorted({r["dL_over_L"] for r in rows}, reverse=True) or [0.5]
-    gold = gold_thresholds(data)
     caption = _caption(rows, usable, gold, panels)
     fig = Figure(figsize=(5.2 * len(panels), 4.6))
     FigureCanvasAgg(fig)
@@ -122,14 +126,7 @@ def write_phase_diagram(out, rows: list[dict], data: Path = DATA) -> tuple[list[
     lines = wrapped.count("\n") + 1
     fig.text(0.01, 0.01, wrapped, fontsize=7, va="bottom", ha="left")
     fig.tight_layout(rect=(0, (lines * 7 * 1.25 + 8) / (4.6 * 72), 1, 1))
-    written = []
-    for suffix in ("png", "pdf"):
-        path = out / f"phase_diagram.{suffix}"
-        tmp = path.with_name(f".phase_diagram.tmp.{suffix}")
-        fig.savefig(tmp, dpi=150)
-        tmp.replace(path)
-        written.append(path)
-    return written, caption
+    return fig, caption
 
 
 def _series(rows: list[dict]) -> list[tuple[str, list[dict]]]:
@@ -175,18 +172,22 @@ def _caption(rows, usable, gold, panels) -> str:
     shown = [g for g in gold if _near(g["dL_over_L"], panels)]
     if not shown:
         return text + " No FEM gold data for these dL/L (data/fem_gold): no reference points, no error bars."
-    with_bars = [g for g in shown if g["dW1_error"] is not None or g["dW2_error"] is not None]
-    text += (f" Black: the FEM shell's gold thresholds (data/fem_gold, {len(shown)} scenes at the paper's "
-             "thickness b = 0.127 mm)")
+    with_bars = [g for g in shown if g["basis"] == "study"]
+    text += (f" Black: the FEM shell's gold thresholds (data/fem_gold, {len(shown)} scene{'s' * (len(shown) != 1)} "
+             "at the paper's thickness b = 0.127 mm)")
     if with_bars:
-        bars = "; ".join(f"{g['scene']}: dW1 +/-{_fmt(g['dW1_error'])}, dW2 +/-{_fmt(g['dW2_error'])}"
-                         for g in with_bars)
-        text += (f", with error bars from their mesh-convergence estimate (Richardson, data/fem_convergence) "
-                 f"where one exists ({bars})")
+        def largest(key):
+            errors = [g[f"{key}_error"] for g in with_bars if g[f"{key}_error"] is not None]
+            return _fmt(max(errors)) if errors else "none"
+
+        every = "every scene" if len(with_bars) == len(shown) else f"{len(with_bars)} of them"
+        text += (f": for {every} the converged value of its mesh study with its error bar (Richardson extrapolation "
+                 "or the finest mesh, fem_reference.convergence; largest dW1 +/-" + largest("dW1")
+                 + ", dW2 +/-" + largest("dW2") + ")")
     rest = len(shown) - len(with_bars)
     if rest:
         text += (f"; {'the other ' if with_bars else ''}{rest} scene{'s' * (rest != 1)} "
-                 f"{'have' if rest != 1 else 'has'} no error estimate and no error bar")
+                 f"{'have' if rest != 1 else 'has'} a single run, no mesh study and no error bar")
     return text + "."
 
 

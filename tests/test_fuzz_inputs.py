@@ -91,6 +91,8 @@ DDG_ENTRY_POINTS = (
     ("ddg.solve.dynamics", "ImplicitEuler", "__init__"),
     ("ddg.solve.dynamics", "ImplicitEuler", "advance"),
     ("ddg.geometry.mesh_io", None, "_gmsh_generate"),
+    # the study generators and the sweep hand their runs to Dask workers here: past every check
+    ("ddg.sweep.cluster", None, "run_all"),
 )
 FEM_ENTRY_POINTS = (
     ("fem_reference.mesh", None, "build_gmsh_model"),

@@ -180,3 +180,19 @@ def test_the_meshes_column_names_the_meshes_a_value_rests_on():
     assert benchmark.basis_meshes(s, "dW1") == ["N96x12", "N144x18", "N216x28"]
     meshes[2] = MeshResult("N144x18", 144, "", 0.264, None)
     assert benchmark.basis_meshes(s, "dW2") == ["N96x12", "N216x28"]
+
+
+def test_the_readme_table_and_count_are_the_committed_benchmark():
+    """README.md's benchmark table and its sentence on the bases are data/benchmark/benchmark.md's
+    (issue 28: the README's table and sentences match the CSV)."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    bench = (root / "data" / "benchmark" / "benchmark.md").read_text().splitlines()
+    readme = (root / "README.md").read_text()
+    table = [line for line in bench if line.startswith("|")]
+    assert "\n".join(table) in readme
+    sentence = next(line for line in bench if "rest on three meshes" in line)
+    assert sentence in " ".join(readme.split())
+    rows = list(__import__("csv").DictReader(open(root / "data" / "benchmark" / "benchmark.csv")))
+    assert sentence == benchmark.basis_sentence([{k: (None if v == "" else v) for k, v in r.items()} for r in rows])

@@ -42,7 +42,7 @@ import sys
 import time
 from pathlib import Path
 
-from benchmarks.common import markdown_table, run_in_child
+from benchmarks.common import markdown_table, run_in_child, write_report
 
 WIDTH_RATIO = 1.0 / 20.0
 COMPRESSION_RATIO = 0.5
@@ -427,7 +427,6 @@ def main(argv=None) -> int:
     import platform
 
     from ddg.analysis.analytic import clamped_elastica_midpoint_height
-    from ddg.output.io import atomic_write_text
 
     ref = gold_reference(gold_dir)
     rows = []
@@ -455,10 +454,7 @@ def main(argv=None) -> int:
               "meshes": [f"{e}:{a}x{c}" for e, a, c in args.meshes], "notes": args.note,
               "machine": f"{os.cpu_count()} cores, {platform.processor() or platform.machine()}, "
                          f"load average {os.getloadavg()[0]:.1f} at the report"}
-    out = Path(args.out)
-    atomic_write_text(out / "fem_element.json", json.dumps(report, indent=1) + "\n")
-    atomic_write_text(out / "fem_element.md", markdown(report))
-    print(f"wrote {out / 'fem_element.json'} and {out / 'fem_element.md'}")
+    print(write_report(args.out, "fem_element", report, markdown(report)))
     return 0
 
 

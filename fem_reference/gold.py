@@ -24,7 +24,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import sys
 import time
 from pathlib import Path
 
@@ -202,7 +201,7 @@ def run_gold(args) -> int:
     into OUT/<scene>/N<along>x<across>/; here, as each one ends, its scene's study and the index.
     Exit 0, 3 if a run stopped short, 1 if one failed; Ctrl-C keeps the finished runs."""
     from ddg.output.interrupts import deferred_signals, signal_name_of
-    from ddg.sweep.cluster import Task, run_all
+    from ddg.sweep.cluster import StudyLog, Task, run_all
     from ddg.sweep.grid import code_version
 
     selected = check_gold_inputs(args)  # before any FEM import and any work
@@ -226,24 +225,13 @@ def run_gold(args) -> int:
             tasks.append(Task(f"fem-gold-{name}-{run_folder_name(along, across)}-{where}", run_mesh,
                               (dL, W, slenderness, along, across, str(target)), along * across,
                               (name, along, across, meshes)))
-    failed, stopped = [], []
 
-    def finished(task, result, error):
-        name, along, across, meshes = task.tag
-        error = error or (result or {}).get("error")
-        if error is not None:
-            failed.append(task)
-            print(f"error: {name} {along} x {across}: {error}", file=sys.stderr, flush=True)
-        else:
-            if not args.quiet:
-                print(f"{name} {along} x {across}: {result['status']}, {result['wall_time_s']:.0f} s, "
-                      f"dW1/L {result['dW1_over_L']}, dW2/L {result['dW2_over_L']}", flush=True)
-            if not result["converged"]:
-                stopped.append(task)
-        write_scene_study(out / name, meshes)
+    def after(task):
+        write_scene_study(out / task.tag[0], task.tag[3])
         write_index(out)
 
-    ran = run_all(tasks, finished, scheduler=scheduler, workers=workers, retries=retries, code=code_version(),
+    log = StudyLog(lambda task, _: f"{task.tag[0]} {task.tag[1]} x {task.tag[2]}", after, args.quiet)
+    ran = run_all(tasks, log, scheduler=scheduler, workers=workers, retries=retries, code=code_version(),
                   shared=out)
     with deferred_signals():  # the index lists what is finished, also after Ctrl-C
         if ran.interrupted is not None:  # runs that ended while the client was stopping
@@ -256,7 +244,7 @@ def run_gold(args) -> int:
                                        f"runs finished and kept in {out}; a rerun computes only the other "
                                        f"{len(tasks) - done}")
         raise ran.interrupted
-    return 1 if failed else 3 if stopped else 0
+    return log.exit_code
 
 
 def scene_runs(folder: Path, meshes=None) -> list[tuple[int, int, Path]]:

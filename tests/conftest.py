@@ -14,3 +14,15 @@ def plate_sixth_fine():
     result = ddg.simulate(strip, protocol, model="plate", resolution=6000, branches=False)
     assert result.converged, result.summary["message"]
     return result
+
+
+@pytest.fixture
+def restore_signal_handlers():
+    """main() installs SIGINT/SIGTERM handlers (ddg.output.interrupts.terminate_as_interrupt): restore them."""
+    import signal
+
+    saved = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    for sig, handler in saved.items():
+        if handler is not None:
+            signal.signal(sig, handler)

@@ -26,14 +26,7 @@ FEM_MODULES = ("dolfinx", "dolfinx.io", "dolfinx.fem", "gmsh", "petsc4py", "slep
 GIB = 2.0**30
 
 
-@pytest.fixture(autouse=True)
-def _signal_handlers():
-    """main() installs SIGINT/SIGTERM handlers (ddg.output.interrupts.terminate_as_interrupt): restore them."""
-    saved = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
-    yield
-    for sig, handler in saved.items():
-        if handler is not None:
-            signal.signal(sig, handler)
+pytestmark = pytest.mark.usefixtures("restore_signal_handlers")  # tests/conftest.py
 
 
 @pytest.fixture

@@ -36,14 +36,7 @@ PLATE_SCENES = ["dL0.5_W0.5", "dL0.25_W0.5"]
 MAP_SCENE, MAP_ROW_SCENE = "dL0.25_W0.05", "dL0.25_W0.05_Lb787"
 
 
-@pytest.fixture(autouse=True)
-def _signal_handlers():
-    """main() installs SIGINT/SIGTERM handlers (ddg.output.interrupts.terminate_as_interrupt): restore them."""
-    saved = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
-    yield
-    for sig, handler in saved.items():
-        if handler is not None:
-            signal.signal(sig, handler)
+pytestmark = pytest.mark.usefixtures("restore_signal_handlers")  # tests/conftest.py
 
 
 @pytest.fixture(scope="module")

@@ -231,26 +231,19 @@ def main(argv=None) -> int:
         write_index(out, args.model)
         return 0
     tasks = study_tasks(out, selected, args.levels, args.model)
-    failed, stopped = [], []
 
-    def finished(task, result, error):
-        name, rows, sequence = task.tag
-        error = error or (result or {}).get("error")
-        if error is not None:
-            failed.append(task)
-            print(f"error: {name} R{rows}: {error}", file=sys.stderr, flush=True)
-        else:
-            if not args.quiet:
-                print(f"{name} R{rows} ({result['triangles']} triangles): {result['status']}, "
-                      f"{result['wall_time_s']:.0f} s, dW1/L {result['dW1_over_L']}, dW2/L {result['dW2_over_L']}",
-                      flush=True)
-            if not result["converged"]:
-                stopped.append(task)
-        write_scene_study(out / name, sequence, args.model)
+    def label(task, result):
+        name, rows, _ = task.tag
+        return f"{name} R{rows}" + ("" if result is None else f" ({result['triangles']} triangles)")
+
+    def after(task):
+        write_scene_study(out / task.tag[0], task.tag[2], args.model)
         write_index(out, args.model)
 
+    log = cluster.StudyLog(label, after, args.quiet)
+
     try:
-        ran = cluster.run_all(tasks, finished, scheduler=scheduler, workers=workers, retries=retries,
+        ran = cluster.run_all(tasks, log, scheduler=scheduler, workers=workers, retries=retries,
                               code=code_version(), shared=out)
     except InputError as exc:  # the scheduler at --scheduler does not answer
         print(f"error: {exc}", file=sys.stderr)
@@ -265,7 +258,7 @@ def main(argv=None) -> int:
         print(f"error: interrupted by {signal_name_of(ran.interrupted)}: {done} of {len(tasks)} runs finished and "
               f"kept in {out}; a rerun computes only the other {len(tasks) - done}", file=sys.stderr)
         return exit_code_of(ran.interrupted)
-    return 1 if failed else 3 if stopped else 0
+    return log.exit_code
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@ import contextlib
 import logging
 import os
 import socket
+import sys
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
@@ -124,6 +125,36 @@ class Ran:
 
     where: str = ""
     interrupted: BaseException | None = None
+
+
+class StudyLog:
+    """The client side of a study generator's runs (fem_reference gold, validation.plate_gold), the
+    `finished` callback of run_all: as each task ends, its line (`label(task, result)`: status, wall
+    time, dW1/L, dW2/L) or its one-line error (`label(task, None)`), the failed and stopped tasks
+    kept, then `after(task)` (its scene's study and the index rewritten)."""
+
+    def __init__(self, label: Callable, after: Callable, quiet: bool = False):
+        self.label, self.after, self.quiet = label, after, quiet
+        self.failed: list[Task] = []
+        self.stopped: list[Task] = []
+
+    def __call__(self, task: Task, result: dict | None, error: str | None) -> None:
+        error = error or (result or {}).get("error")
+        if error is not None:
+            self.failed.append(task)
+            print(f"error: {self.label(task, None)}: {error}", file=sys.stderr, flush=True)
+        else:
+            if not self.quiet:
+                print(f"{self.label(task, result)}: {result['status']}, {result['wall_time_s']:.0f} s, "
+                      f"dW1/L {result['dW1_over_L']}, dW2/L {result['dW2_over_L']}", flush=True)
+            if not result["converged"]:
+                self.stopped.append(task)
+        self.after(task)
+
+    @property
+    def exit_code(self) -> int:
+        """1 if a run failed, 3 if one stopped short, else 0."""
+        return 1 if self.failed else 3 if self.stopped else 0
 
 
 class WorkerMismatch(RuntimeError):

@@ -307,10 +307,7 @@ def evaluate(key: str, measured, missing: str = "", needs: str = "") -> dict:
                  + (f" at {where}" if where else ""))
         worst = (f"; largest difference {measured.difference:.4g}, largest combined error bar "
                  f"{measured.combined_error_bar:.4g} over {measured.points} compared point(s)")
-        if measured.short:
-            out["reason"] = f"fails: {measured.short}; {point}{worst}"
-        else:
-            out["reason"] = f"{outcome}: {point}{worst}"
+        out["reason"] = (f"{measured.short}; " if measured.short else "") + point + worst
         return out
     value = None if measured is None or not np.isfinite(measured) else abs(float(measured))
     if value is None:

@@ -124,7 +124,7 @@ def check_gold_inputs(args) -> list[tuple[str, float, float, list[tuple[int, int
         if unknown:
             raise InputError(f"--only: unknown gold scene(s) {', '.join(map(repr, unknown))}; "
                              f"choose from {', '.join(known)}")
-    levels = check_integer("--levels", LEVELS if args.levels is None else args.levels, 1, 4,
+    levels = check_integer("--levels", LEVELS if args.levels is None else args.levels, 1, MAX_LEVELS,
                            "meshes per scene (3 for Richardson extrapolation with an observed order)")
     base = BASE_RESOLUTION if args.resolution is None else args.resolution
     selected = []

@@ -655,6 +655,12 @@ def test_the_worst_point_decides_and_a_short_reference_fails(monkeypatch):
     assert whole.short == "" and C.evaluate("synthetic", whole)["outcome"] == "holds"
 
 
+def test_an_agreement_without_its_points_is_judged_on_its_largest_figures(monkeypatch):
+    monkeypatch.setitem(C.CLAIMS, "synthetic", _agreement_claim())
+    assert C.evaluate("synthetic", C.Agreement(0.02, 0.005, 0.015))["outcome"] == "fails"
+    assert C.evaluate("synthetic", C.Agreement(0.005, 0.005, 0.0))["outcome"] == "holds"
+
+
 def test_a_claim_without_data_fails():
     verdict = C.evaluate("plate_vs_fem_dW1", None, "no FEM study dL0.5_W0.1667")
     assert verdict["outcome"] == "fails" and verdict["reason"].startswith("no data")

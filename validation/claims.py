@@ -175,12 +175,12 @@ class Agreement:
 
     def deciding(self, claim: Claim) -> tuple[str, tuple]:
         """The claim's outcome over the compared points, and the point that decides it (the
-        largest difference among the points of that outcome)."""
-        if not self.pairs:
-            return "holds", (self.difference, self.combined_error_bar, self.where)
-        outcomes = [claim.outcome_at(d, c) for d, c, _ in self.pairs]
+        largest difference among the points of that outcome); an Agreement made without its
+        points is judged on its largest difference and combined error bar as one point."""
+        pairs = self.pairs or ((self.difference, self.combined_error_bar, self.where),)
+        outcomes = [claim.outcome_at(d, c) for d, c, _ in pairs]
         outcome = max(outcomes, key=OUTCOMES.index)
-        worst = max((p for p, o in zip(self.pairs, outcomes) if o == outcome), key=lambda p: p[0])
+        worst = max((p for p, o in zip(pairs, outcomes) if o == outcome), key=lambda p: p[0])
         return outcome, worst
 
     @classmethod

@@ -13,10 +13,6 @@ ROOT = Path(__file__).resolve().parents[1]
 MANIFEST = ROOT / "tests" / "large_files.txt"
 #: Largest tracked file that needs no manifest entry (bytes).
 LIMIT = 1_000_000
-#: Reader of the entries with no reader: the study runs' centerline.csv, which nothing reads and
-#: which are being removed (issue 28); this exception goes when the lead has deleted them and
-#: their manifest lines.
-NO_READER = "-"
 
 
 def tracked_files() -> list[str]:
@@ -60,11 +56,6 @@ def test_every_manifest_entry_is_a_large_tracked_file_its_reader_reads():
     for path, (reader, texts) in manifest().items():
         assert path in tracked, f"{path} is listed but not tracked (remove its line)"
         assert size(path) > LIMIT, f"{path} is {size(path)} bytes, within the limit: remove its line"
-        if reader == NO_READER:
-            # only the study runs' centerline.csv being removed (issue 28) may have no reader
-            assert Path(path).name == "centerline.csv" and path.startswith("data/"), \
-                f"{path} lists no reader; only the data/ runs' centerline.csv being removed may"
-            continue
         assert reader in tracked and reader != path, f"{path}: its reader {reader} is not a tracked file"
         text = (ROOT / reader).read_text(errors="replace")
         missing = [t for t in texts if t not in text]

@@ -293,6 +293,7 @@ class Observer:
             "branch_switched": bool(switched),
             **m.resolution_indicators(),
             "negative_eigenvalues": int(negative),
+            "stretching_share": m.stretching_share(),
             "half_turn_defect_over_L": mirror,
             "point_reflection_defect_over_L": point,
             "wall_time_s": wall,

@@ -311,6 +311,11 @@ class NaghdiStrip:
         """Pi in units of D (multiply by E b^3 / 12 for J)."""
         return float(fem.assemble_scalar(self.energy_form))
 
+    def stretching_share(self) -> float:
+        """Membrane energy (its PSRI mix, as in the energy) over the whole energy; 0 unloaded."""
+        total = self.energy()
+        return float(fem.assemble_scalar(self.membrane_energy_form)) / total if total > 0.0 else 0.0
+
     def clamp_reaction(self) -> np.ndarray:
         """Force the moving clamp applies to the strip, units of D / L (sum of the residual over
         the clamp's displacement DOFs: virtual work of a rigid clamp translation)."""

@@ -50,11 +50,13 @@ def test_hinge_angle_derivatives_match_finite_differences(seed):
 
 
 # ---------------------------------------------------------------------------- assembled derivatives
+@pytest.mark.parametrize("membrane", ["psri", "full"])
 @pytest.mark.parametrize("nu", [0.0, 0.3])
 @pytest.mark.parametrize("seed", range(2))
-def test_model_gradient_and_hessian_match_finite_differences(nu, seed):
-    s = strip(nu=nu)
-    model = MidedgePlateModel(s, rows=4)
+def test_model_gradient_and_hessian_match_finite_differences(nu, seed, membrane):
+    s = strip(nu=nu, slenderness=30.0)  # b / h ~ 0.8 at 4 rows: both membrane parts weigh
+    model = MidedgePlateModel(s, rows=4, membrane=membrane)
+    assert 0.3 < model.membrane_alpha < 1.0 if membrane == "psri" else model.membrane_alpha == 1.0
     rng = np.random.default_rng(seed)
     q = model.buckled_guess(0.3 * s.length)
     q += 1e-3 * s.length * rng.standard_normal(model.n_dof)
@@ -137,6 +139,44 @@ def test_uniform_strain_has_the_plane_stress_energy(nu):
     modulus = s.young_modulus * s.thickness / (2 * (1 - nu**2))
     density = modulus * (nu * np.trace(eps) ** 2 + (1 - nu) * np.sum(eps * eps))
     assert energy == pytest.approx(density * mesh.triangle_areas.sum(), rel=1e-5)
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3])
+@pytest.mark.parametrize("angle", [0.0, 0.7])
+def test_node_smoothed_membrane_keeps_the_plane_stress_energy_of_a_uniform_strain(nu, angle):
+    """A homogeneous strain, rigidly rotated out of the plane: every patch has the triangles'
+    strain, so the smoothed energy is the plane-stress energy of the Green strain times the area
+    (Green strain: objective), as the constant-strain triangles'. The model's patches leave out
+    the rigid ghost triangles beyond the clamps (strained here, never in a run)."""
+    s = strip(nu=nu, slenderness=30.0)
+    full, psri = MidedgePlateModel(s, rows=4, membrane="full"), MidedgePlateModel(s, rows=4)
+    eps = 1e-4 * np.array([[1.0, 0.3], [0.3, -0.5]])
+    x = np.zeros((full.mesh.node_count, 3))
+    x[:, :2] = full.mesh.nodes @ (np.eye(2) + eps).T
+    c, si = np.cos(angle), np.sin(angle)
+    x = x @ np.array([[1.0, 0.0, 0.0], [0.0, c, -si], [0.0, si, c]]).T
+    q = full.rest_state()
+    q[full.node_dofs] = x
+    green = eps + 0.5 * eps.T @ eps
+    modulus = s.young_modulus * s.thickness / (2 * (1 - nu**2))
+    density = modulus * (nu * np.trace(green) ** 2 + (1 - nu) * np.sum(green * green))
+    clamped = full.mesh.clamped_left | full.mesh.clamped_right
+    areas = full.mesh.triangle_areas
+    free_area = areas[~clamped[full.mesh.triangles].all(axis=1)].sum()
+    assert full.evaluate(q, gradient=False).parts["stretching"] == pytest.approx(density * areas.sum(), rel=1e-9)
+    alpha = psri.membrane_alpha
+    expected = density * (alpha * areas.sum() + (1 - alpha) * free_area)
+    assert psri.evaluate(q, gradient=False).parts["stretching"] == pytest.approx(expected, rel=1e-9)
+
+
+def test_psri_weight_is_the_shells_b2_over_h2():
+    """alpha = b^2 / h^2 with h the mesh's typical spacing (as the shell reference's PSRI)."""
+    s = strip(slenderness=1181.1)
+    model = MidedgePlateModel(s, rows=8)
+    assert model.membrane_alpha == pytest.approx((s.thickness / model._typical_spacing()) ** 2)
+    assert model.membrane_alpha < 0.01
+    with pytest.raises(InputError, match="membrane"):
+        MidedgePlateModel(s, rows=8, membrane="reduced")
 
 
 # ---------------------------------------------------------------------------- narrow-strip limit

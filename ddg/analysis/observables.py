@@ -3,7 +3,9 @@
 H_mid / L: height (z) of the centerline point at s = L/2; F_shear_norm = F_y L / (E b^3)
 with F the force the moving clamp applies to the strip (App. E: from the force balance at
 the constrained DOFs); F_axial_norm = P L / (E b^3) with P the compressive clamp force;
-lambda_min: lowest normalised eigenvalue of the free-DOF Hessian (see the model).
+lambda_min: lowest normalised eigenvalue of the free-DOF Hessian (see the model);
+stretching_share: the stretching (membrane) part of the elastic energy over the whole, the
+measure of membrane locking (issue 29: a thin strip stores almost all its energy in bending).
 """
 from __future__ import annotations
 
@@ -13,7 +15,7 @@ from ..solve.state import phase_label
 
 PATH_COLUMNS = ("stage", "dL_over_L", "dW_over_L", "H_mid_over_L", "F_shear_norm", "energy", "lambda_min", "phase")
 EXTRA_COLUMNS = ("F_axial_norm", "stable", "newton_iterations", "branch_switched", "max_turn_angle_deg",
-                 "max_strain", "negative_eigenvalues")
+                 "max_strain", "negative_eigenvalues", "stretching_share")
 
 #: Beyond this angle between neighbouring elements (edges of the rod, triangles of the plate) the
 #: discretisation no longer resolves the shape (e.g. the conical singularities that form at the
@@ -42,7 +44,14 @@ def observe(model, state, stage: str, eigenvalues: bool = True) -> dict:
         "branch_switched": bool(state.branch_switched),
         **model.resolution_indicators(state.q),
         "negative_eigenvalues": negative_eigenvalues(model, ev.hessian),
+        "stretching_share": stretching_share(ev),
     }
+
+
+def stretching_share(evaluation) -> float:
+    """Stretching energy over the elastic energy (0 in the unloaded state)."""
+    energy = float(evaluation.energy)
+    return float(evaluation.parts.get("stretching", 0.0)) / energy if energy > 0.0 else 0.0
 
 
 def negative_eigenvalues(model, hessian) -> int | None:

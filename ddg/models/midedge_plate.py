@@ -5,7 +5,10 @@ the same kinematics for the nodes but its own energies, chosen so that the plate
 second order with the mesh and its continuum limit is the Kirchhoff plate of the strip's
 material (Young's modulus E, Poisson ratio nu for both membrane and bending):
 
-- membrane: constant-strain triangles (ddg.energies.membrane), plane-stress St Venant-Kirchhoff;
+- membrane: constant-strain triangles (ddg.energies.membrane), plane-stress St Venant-Kirchhoff,
+  by default mixed as the shell's partial selective reduced integration: alpha = b^2 / h^2 of
+  them and 1 - alpha of their node-smoothed strains (ddg.energies.smoothed_membrane), which
+  removes the membrane locking of coarse thin meshes (issue 29; `membrane="full"`: all CST);
 - bending: mid-edge normals (ddg.energies.midedge_bending): one angle DOF per edge, the
   triangle's second fundamental form from its three mid-edge normals (Morley's element when
   linearised), density D/2 [nu tr(M)^2 + (1 - nu) tr(M^2)] with D = E b^3 / (12 (1 - nu^2)).
@@ -28,10 +31,18 @@ import numpy as np
 
 from ..energies.membrane import add_membrane_terms, face_membrane_matrices
 from ..energies.midedge_bending import ROLE_FIRST, ROLE_SECOND, add_midedge_terms, face_bending_matrices
+from ..energies.smoothed_membrane import add_smoothed_membrane_terms, node_patches, plane_stress_matrix, strain_maps
 from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, ghost_clamp_mesh
 from ..geometry.strip import InputError, Strip
 from .base import Evaluation
 from .plate import PlateModel
+
+
+#: Membrane discretisations: "psri", alpha = min(1, b^2 / h^2) of the constant-strain triangles and
+#: the rest node-smoothed (ddg.energies.smoothed_membrane), the treatment of membrane locking as
+#: the shell reference's partial selective reduced integration; "full", the constant-strain
+#: triangles alone (locks on coarse thin plates: issue 29).
+MEMBRANES = ("psri", "full")
 
 
 class MidedgePlateModel(PlateModel):
@@ -41,8 +52,11 @@ class MidedgePlateModel(PlateModel):
     name = "plate-midedge"
 
     def __init__(self, strip: Strip, triangles: int = DEFAULT_TRIANGLES, *, rows: int | None = None,
-                 mesh: PlateMesh | None = None):
+                 mesh: PlateMesh | None = None, membrane: str = "psri"):
+        if membrane not in MEMBRANES:
+            raise InputError(f"membrane = {membrane!r} must be one of {', '.join(MEMBRANES)}")
         self.strip = strip
+        self.membrane = membrane
         if mesh is None:
             mesh = ghost_clamp_mesh(strip.length, strip.width, triangles, rows=rows)
         elif mesh.clamp_depth != 0.0:
@@ -101,6 +115,11 @@ class MidedgePlateModel(PlateModel):
         E, b, nu = strip.young_modulus, strip.thickness, strip.poisson_ratio
         self._membrane, self._abar = face_membrane_matrices(nodes, tris, E, b, nu)
         self._bending = face_bending_matrices(nodes, tris, E, b, nu)
+        self._strain_T, _, areas = strain_maps(nodes, tris)
+        self._patches = node_patches(tris, areas, n_nodes, active=~rigid)
+        self._plane_stress = plane_stress_matrix(E, b, nu)
+        #: share of the full constant-strain membrane; the rest is the node-smoothed one
+        self.membrane_alpha = min(1.0, (b / self._typical_spacing()) ** 2) if membrane == "psri" else 1.0
         self._triangles = np.ascontiguousarray(tris, dtype=np.int64)
         self._face_edges = np.ascontiguousarray(face_edges, dtype=np.int64)
         self._roles = np.ascontiguousarray(roles, dtype=np.int64)
@@ -129,8 +148,13 @@ class MidedgePlateModel(PlateModel):
         hessian = hessian and gradient
         n = self.n_dof
         grad, band = self._accumulators(gradient, hessian)
-        stretching = add_membrane_terms(x, self._triangles, self._membrane, self._abar, self._node_dofs, n,
+        alpha = self.membrane_alpha
+        stretching = add_membrane_terms(x, self._triangles, alpha * self._membrane, self._abar, self._node_dofs, n,
                                         grad, band, gradient, hessian)
+        if alpha < 1.0:
+            stretching += add_smoothed_membrane_terms(x, self._triangles, self._strain_T, self._abar, *self._patches,
+                                                      self._plane_stress, 1.0 - alpha, self._node_dofs, n,
+                                                      grad, band, gradient, hessian)
         bending = add_midedge_terms(x, theta, self._triangles, self._face_edges, self._roles, self._hinge_of_edge,
                                     self._hinges, self._bending, self._node_dofs, self._edge_dofs, n,
                                     grad, band, gradient, hessian)

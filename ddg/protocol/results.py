@@ -118,6 +118,9 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
         "warnings": [],
         "unresolved_thresholds": {},
         "mesh": model.mesh.as_dict() if hasattr(model, "mesh") else None,
+        # the mid-edge plate's membrane discretisation ("psri" and its alpha, or "full"); null for the others
+        "membrane": {"discretisation": model.membrane, "alpha": model.membrane_alpha}
+        if hasattr(model, "membrane_alpha") else None,
         "lambda_min_normalisation": "lowest eigenvalue of K v = lambda D v (lumped metric D), times L^4 / EI2",
         "versions": versions(),
     }

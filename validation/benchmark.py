@@ -41,14 +41,14 @@ MISSING = "\u2013"   # en dash: no data
 
 LEGEND = (
     "dW1/L and dW2/L are the clamp shears at the pitchfork (U -> US) and at the snap (US -> S) in units of "
-    "L; W\u00b2/(bL) is the width squared over thickness times length (L/b = 1181.1). Each FEM (data/fem_gold) "
-    "and plate (data/plate_gold) value is the converged value of that model's mesh study of the scene, "
+    "L; W\u00b2/(bL) is the width squared over thickness times length (L/b = 1181.1). Each FEM (data/fem_gold), "
+    "plate (the paper's, data/plate_gold) and mid-edge plate (data/midedge_gold) value is the converged value of that model's mesh study of the scene, "
     "\u00b1 its error bar: fem_reference.convergence.estimate, i.e. the Richardson extrapolation with the "
     "observed order and Roache's grid convergence index as error bar where the finest three meshes are in "
     "the asymptotic range (safety factor 1.25 at an observed order of 1.5 or more, 3 below), else the finest "
     "mesh's value with three times the largest difference of the finest three meshes as error bar (the rule "
     "of data/fem_gold/README.md), plus the bisection tolerance of the threshold. |diff|/combined is "
-    "|plate - FEM| divided by the "
+    "|plate - FEM| (or |mid-edge - FEM|) divided by the "
     "combined error bar, the sum of the two error bars (validation.claims.threshold_agreement). Paper: the "
     "values quoted in the text of Huang, Wang, Li, Jawed (at dL/L = 1/4 and W/L > 1/20, 0.23 times the "
     "quoted percent drop). Rod: the converged value of the rod's study on M = 50/100/200 elements, the "
@@ -107,6 +107,7 @@ def benchmark_rows(rod_thresholds: dict | None = None, load=None) -> list[dict]:
         strip = ddg.Strip.from_ratios(width, compression)
         fem = _safe_load(load, "fem", compression, width)
         plate = _safe_load(load, "plate", compression, width)
+        midedge = _safe_load(load, "plate-midedge", compression, width)
         rod = (rod_thresholds or {}).get(gold_name(compression, width)) or {}
         row = {"compression_ratio": compression, "width_ratio": width,
                "width_squared_over_thickness_length": width**2 * strip.slenderness}
@@ -118,6 +119,12 @@ def benchmark_rows(rod_thresholds: dict | None = None, load=None) -> list[dict]:
                                         else plate_value - fem_value)
             agreement = None if fem is None or plate is None else threshold_agreement(plate, fem, key)
             row[f"{key}_in_error_bars"] = None if agreement is None else agreement.in_error_bars
+            row.update(_study_columns("midedge", midedge, key))
+            midedge_value = row[f"midedge_{key}"]
+            row[f"midedge_{key}_difference"] = (None if fem_value is None or midedge_value is None
+                                                else midedge_value - fem_value)
+            agreement = None if fem is None or midedge is None else threshold_agreement(midedge, fem, key)
+            row[f"midedge_{key}_in_error_bars"] = None if agreement is None else agreement.in_error_bars
             row[f"paper_{key}"] = paper_value(compression, width, key)
             row[f"rod_{key}"] = rod.get(key)
             row[f"rod_{key}_error_bar"] = rod.get(f"{key}_error_bar")
@@ -185,16 +192,19 @@ def _with_bar(value, error_bar) -> str:
 
 def markdown_table(rows: list[dict]) -> str:
     """The benchmark as a markdown table (no legend), one line per row of benchmark_rows()."""
-    lines = ["| dL/L | W/L | W\u00b2/(bL) | FEM dW1/L | plate dW1/L | \\|diff\\|/combined | FEM dW2/L | "
-             "plate dW2/L | \\|diff\\|/combined | paper dW1/L | paper dW2/L | rod dW1/L | rod dW2/L |",
-             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    lines = ["| dL/L | W/L | W\u00b2/(bL) | FEM dW1/L | plate dW1/L | \\|diff\\|/combined | mid-edge dW1/L | "
+             "\\|diff\\|/combined | FEM dW2/L | plate dW2/L | \\|diff\\|/combined | mid-edge dW2/L | "
+             "\\|diff\\|/combined | paper dW1/L | paper dW2/L | rod dW1/L | rod dW2/L |",
+             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         cells = [fraction_label(r["compression_ratio"]), fraction_label(r["width_ratio"]),
                  _number(r["width_squared_over_thickness_length"], "{:.1f}")]
         for key in THRESHOLDS:
             cells += [_with_bar(r[f"fem_{key}"], r[f"fem_{key}_error_bar"]),
                       _with_bar(r[f"plate_{key}"], r[f"plate_{key}_error_bar"]),
-                      _number(r[f"{key}_in_error_bars"], "{:.1f}")]
+                      _number(r[f"{key}_in_error_bars"], "{:.1f}"),
+                      _with_bar(r[f"midedge_{key}"], r[f"midedge_{key}_error_bar"]),
+                      _number(r[f"midedge_{key}_in_error_bars"], "{:.1f}")]
         cells += [_number(r["paper_dW1"]), _number(r["paper_dW2"]),
                   _with_bar(r["rod_dW1"], r["rod_dW1_error_bar"]), _with_bar(r["rod_dW2"], r["rod_dW2_error_bar"])]
         lines.append("| " + " | ".join(cells) + " |")
@@ -213,7 +223,7 @@ def basis_counts(rows: list[dict], prefix: str = "fem") -> dict:
 def basis_sentence(rows: list[dict]) -> str:
     """One sentence counting the bases of the FEM and plate entries (benchmark.md, README)."""
     parts = []
-    for prefix, name in (("fem", "FEM"), ("plate", "plate")):
+    for prefix, name in (("fem", "FEM"), ("plate", "plate"), ("midedge", "mid-edge plate")):
         c = basis_counts(rows, prefix)
         parts.append(f"{c['three_meshes']} of the {c['entries']} {name} entries rest on three meshes, "
                      f"{c['asymptotic']} of them asymptotic")

@@ -89,6 +89,14 @@ def _share_at(rows: list[dict], dw: float) -> float | None:
     return min(shear, key=lambda r: abs(r["dW_over_L"] - dw)).get("stretching_share")
 
 
+def tabulate_run(folder: Path) -> dict:
+    """{dW/L as text: stretching share of U there} of one stored run (SHARE_AT)."""
+    from ddg.output.io import StoredRun
+
+    rows = StoredRun(str(folder)).rows
+    return {f"{dw:g}": _share_at(rows, dw) for dw in SHARE_AT}
+
+
 def tabulate(out: Path) -> dict:
     from ddg.output.io import StoredRun
 
@@ -108,7 +116,7 @@ def tabulate(out: Path) -> dict:
                             "dW1_over_L": s.get("dW1_over_L"), "newton_iterations": s.get("newton_iterations"),
                             "wall_time_s": s.get("wall_time_s"), "folds": len(s.get("folds_dW_over_L") or []),
                             "alpha": (s.get("membrane") or {}).get("alpha"),
-                            "stretching_share": {f"{dw:g}": _share_at(run.rows, dw) for dw in SHARE_AT}})
+                            "stretching_share": tabulate_run(folder / name)})
     summary = {"scene": {"width_ratio": WIDTH_RATIO, "compression_ratio": COMPRESSION_RATIO,
                          "shear_ratio": SHEAR_RATIO}, "runs": entries}
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")

@@ -51,6 +51,8 @@ def add_membrane_terms(x, triangles, C, abar, vertex_dof, n, grad, band, want_gr
     J = np.empty((3, 9))
     block = np.empty((9, 9))
     delta = np.empty(3)
+    Cd = np.empty(3)
+    CJ = np.empty((3, 9))
     for f in range(triangles.shape[0]):
         p0, p1, p2 = triangles[f, 0], triangles[f, 1], triangles[f, 2]
         e1 = x[p1] - x[p0]
@@ -58,7 +60,10 @@ def add_membrane_terms(x, triangles, C, abar, vertex_dof, n, grad, band, want_gr
         delta[0] = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] - abar[f, 0]
         delta[1] = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2] - abar[f, 1]
         delta[2] = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2] - abar[f, 2]
-        Cd = C[f] @ delta
+        Cd0 = C[f, 0, 0] * delta[0] + C[f, 0, 1] * delta[1] + C[f, 0, 2] * delta[2]
+        Cd1 = C[f, 1, 0] * delta[0] + C[f, 1, 1] * delta[1] + C[f, 1, 2] * delta[2]
+        Cd2 = C[f, 2, 0] * delta[0] + C[f, 2, 1] * delta[1] + C[f, 2, 2] * delta[2]
+        Cd[0], Cd[1], Cd[2] = Cd0, Cd1, Cd2
         energy += 0.5 * (delta[0] * Cd[0] + delta[1] * Cd[1] + delta[2] * Cd[2])
         if not want_gradient:
             continue
@@ -74,7 +79,9 @@ def add_membrane_terms(x, triangles, C, abar, vertex_dof, n, grad, band, want_gr
             grad[dofs[c]] += J[0, c] * Cd[0] + J[1, c] * Cd[1] + J[2, c] * Cd[2]
         if not want_hessian:
             continue
-        CJ = C[f] @ J
+        for a in range(3):
+            for c in range(9):
+                CJ[a, c] = C[f, a, 0] * J[0, c] + C[f, a, 1] * J[1, c] + C[f, a, 2] * J[2, c]
         for r in range(9):
             for c in range(9):
                 block[r, c] = J[0, r] * CJ[0, c] + J[1, r] * CJ[1, c] + J[2, r] * CJ[2, c]

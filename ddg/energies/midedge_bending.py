@@ -88,7 +88,7 @@ def _cross(a, b, out):
     out[2] = a[0] * b[1] - a[1] * b[0]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _normal_jacobian(p, slots, J):
     """J (3, 12) = du/dq of u = (p1 - p0) x (p2 - p0) for the triangle on hinge slots (s0, s1, s2):
     du = sum_i dp_i x c_i, c_i = p_{i+1} - p_{i+2}, i.e. du/dp_i = -[c_i]x."""
@@ -103,17 +103,26 @@ def _normal_jacobian(p, slots, J):
         J[2, col + 0], J[2, col + 1] = c1, -c0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _add_bilinear(slots, w, scale, H):
     """H += scale * Hessian of w . u in the 12 hinge coordinates (u of the triangle on `slots`):
     blocks (i, i+1) = -[w]x, (i+1, i) = +[w]x."""
-    skew = np.array([[0.0, w[2], -w[1]], [-w[2], 0.0, w[0]], [w[1], -w[0], 0.0]])  # -[w]x
+    # -[w]x = [[0, w2, -w1], [-w2, 0, w0], [w1, -w0, 0]] (scalars: no array per call)
+    w0, w1, w2 = scale * w[0], scale * w[1], scale * w[2]
     for i in range(3):
         r, c = 3 * slots[i], 3 * slots[(i + 1) % 3]
-        for a in range(3):
-            for b in range(3):
-                H[r + a, c + b] += scale * skew[a, b]
-                H[c + b, r + a] += scale * skew[a, b]
+        H[r + 0, c + 1] += w2
+        H[c + 1, r + 0] += w2
+        H[r + 0, c + 2] -= w1
+        H[c + 2, r + 0] -= w1
+        H[r + 1, c + 0] -= w2
+        H[c + 0, r + 1] -= w2
+        H[r + 1, c + 2] += w0
+        H[c + 2, r + 1] += w0
+        H[r + 2, c + 0] += w1
+        H[c + 0, r + 2] += w1
+        H[r + 2, c + 1] -= w0
+        H[c + 1, r + 2] -= w0
 
 
 _SLOTS_A = np.array([0, 1, 2], dtype=np.int64)  # a = (v0, v1, o_a)
@@ -128,10 +137,11 @@ def hinge_angle(p, want_gradient, want_hessian, grad, hess):
     Ja, Jb, HX, HT, t3, dX, dT, dl, dY = (np.empty((3, 12)), np.empty((3, 12)), np.empty((12, 12)),
                                           np.empty((12, 12)), np.empty((3, 12)), np.empty(12), np.empty(12),
                                           np.empty(12), np.empty(12))
-    return hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT, t3, dX, dT, dl, dY)
+    return hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT, t3, dX, dT, dl, dY,
+                            np.empty((6, 3)))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _add_transposed_products(J1, J2, t3, r, scale, H):
     """H += scale (J1^T (-[r]x) J2 + its transpose): the second variation (dp x dq) . r; t3 (3, 12) scratch."""
     for k in range(12):
@@ -150,18 +160,18 @@ def _add_transposed_products(J1, J2, t3, r, scale, H):
 
 
 @njit(cache=True)
-def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT, t3, dX, dT, dl, dY):
+def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT, t3, dX, dT, dl, dY, vec):
     """hinge_angle with the caller's scratch arrays (allocated once per assembly, not per hinge)."""
     e0, e1, e2 = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
     w0, w1, w2 = p[2, 0] - p[0, 0], p[2, 1] - p[0, 1], p[2, 2] - p[0, 2]
-    ua = np.array([e1 * w2 - e2 * w1, e2 * w0 - e0 * w2, e0 * w1 - e1 * w0])
+    ua, ub, e, ubxua, uaxe, exub = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5]
+    ua[0], ua[1], ua[2] = e1 * w2 - e2 * w1, e2 * w0 - e0 * w2, e0 * w1 - e1 * w0
     f0, f1, f2 = -e0, -e1, -e2
     w0, w1, w2 = p[3, 0] - p[1, 0], p[3, 1] - p[1, 1], p[3, 2] - p[1, 2]
-    ub = np.array([f1 * w2 - f2 * w1, f2 * w0 - f0 * w2, f0 * w1 - f1 * w0])
-    e = np.array([e0, e1, e2])
+    ub[0], ub[1], ub[2] = f1 * w2 - f2 * w1, f2 * w0 - f0 * w2, f0 * w1 - f1 * w0
+    e[0], e[1], e[2] = e0, e1, e2
     length = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
     X = ua[0] * ub[0] + ua[1] * ub[1] + ua[2] * ub[2]
-    ubxua = np.empty(3)
     _cross(ub, ua, ubxua)
     T = ubxua[0] * e0 + ubxua[1] * e1 + ubxua[2] * e2
     Y = T / length
@@ -170,7 +180,6 @@ def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT,
         return psi
     _normal_jacobian(p, _SLOTS_A, Ja)
     _normal_jacobian(p, _SLOTS_B, Jb)
-    uaxe, exub = np.empty(3), np.empty(3)
     _cross(ua, e, uaxe)
     _cross(e, ub, exub)
     # Je = [-I, I, 0, 0] (e = v1 - v0) is applied by hand below
@@ -207,24 +216,31 @@ def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT,
     _add_transposed_products(Ja, _JE, t3, ub, 1.0, HT)
     _add_transposed_products(_JE, Jb, t3, ua, 1.0, HT)
     inv_l = 1.0 / length
+    inv_l2 = inv_l * inv_l
+    inv_l3 = inv_l2 * inv_l
+    inv_r2 = 1.0 / R2
+    inv_r4 = inv_r2 * inv_r2
+    # per-index factors hoisted out of the 12 x 12 loop (t3 is free scratch here):
+    # t3[0] = g = X dY - Y dX, t3[1] = 2 X dX + 2 Y dY
     for i in range(12):
+        t3[0, i] = X * dY[i] - Y * dX[i]
+        t3[1, i] = 2.0 * X * dX[i] + 2.0 * Y * dY[i]
+    for i in range(12):
+        gi, ci, dTi, dli, dXi, dYi = t3[0, i], t3[1, i], dT[i], dl[i], dX[i], dY[i]
         for k in range(i, 12):
             # Hessian of l = |e|: Je^T (I - e e^T / l^2) Je / l, nonzero on the (v0, v1) blocks
             hl = 0.0
             if i < 6 and k < 6:
                 a, b = i % 3, k % 3
                 sign = (1.0 if (i < 3) == (k < 3) else -1.0)
-                hl = sign * ((1.0 if a == b else 0.0) - e[a] * e[b] * inv_l * inv_l) * inv_l
-            hy = (HT[i, k] * inv_l - (dT[i] * dl[k] + dl[i] * dT[k]) * inv_l * inv_l - T * hl * inv_l * inv_l
-                  + 2.0 * T * dl[i] * dl[k] * inv_l**3)
-            gi = X * dY[i] - Y * dX[i]
-            gk = X * dY[k] - Y * dX[k]
-            h_ik = (X * hy - Y * HX[i, k] + dY[i] * dX[k] - dX[i] * dY[k]) / R2 \
-                - gi * (2.0 * X * dX[k] + 2.0 * Y * dY[k]) / (R2 * R2)
-            h_ki = (X * hy - Y * HX[i, k] + dY[k] * dX[i] - dX[k] * dY[i]) / R2 \
-                - gk * (2.0 * X * dX[i] + 2.0 * Y * dY[i]) / (R2 * R2)
-            hess[i, k] = 0.5 * (h_ik + h_ki)
-            hess[k, i] = hess[i, k]
+                hl = sign * ((1.0 if a == b else 0.0) - e[a] * e[b] * inv_l2) * inv_l
+            hy = (HT[i, k] * inv_l - (dTi * dl[k] + dli * dT[k]) * inv_l2 - T * hl * inv_l2
+                  + 2.0 * T * dli * dl[k] * inv_l3)
+            # the antisymmetric terms dY_i dX_k - dX_i dY_k cancel in the symmetrised sum
+            common = (X * hy - Y * HX[i, k]) * inv_r2
+            v = common - 0.5 * (gi * t3[1, k] + t3[0, k] * ci) * inv_r4
+            hess[i, k] = v
+            hess[k, i] = v
     return psi
 
 
@@ -257,6 +273,7 @@ def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge
                                           np.empty(12), np.empty(12))
     kphi = np.empty(3)
     KJ = np.empty((3, 21))
+    vec = np.empty((6, 3))
     for f in range(triangles.shape[0]):
         m = 0
         for a in range(3):
@@ -293,7 +310,8 @@ def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge
                         dofs[m + k] = vertex_dof[v, k]
                     m += 3
                 slot_of[s] = found
-            psi = hinge_angle_into(pts, want_gradient, want_hessian, gloc, hloc, Ja, Jb, HX, HT, t3, dX, dT, dl, dY)
+            psi = hinge_angle_into(pts, want_gradient, want_hessian, gloc, hloc, Ja, Jb, HX, HT, t3, dX, dT, dl, dY,
+                                   vec)
             phi[i] = -(theta[e] + psi)
             if want_gradient:
                 for s in range(4):

@@ -277,10 +277,10 @@ def calibration_note(rows: list[dict]) -> str:
 def markdown(report: dict) -> str:
     ref, rows, v = report["gold"], report["runs"], report["verdict"]
     lines = ["# FEM shell elements: accuracy per CPU second (issue 28 item 2)", "",
-             f"Scene: W/L = 1/20, dL/L = 1/2, L/b = 1181 (the paper strip), the whole default path (40 compression "
-             f"and 120 shear steps, branch switch), dW1 and dW2 bisected to 1e-4 L as the gold runs. "
-             f"P2B3: u in [P2 + B3]^3, theta in [P2]^2, PSRI degrees 4/2 (the default); P3: u in [P3]^3, "
-             f"theta in [P3]^2, PSRI degrees 6/4 (fem_reference/elements.py).", "",
+             "Scene: W/L = 1/20, dL/L = 1/2, L/b = 1181 (the paper strip), the whole default path (40 compression "
+             "and 120 shear steps, branch switch), dW1 and dW2 bisected to 1e-4 L as the gold runs. "
+             "P2B3: u in [P2 + B3]^3, theta in [P2]^2, PSRI degrees 4/2 (the default); P3: u in [P3]^3, "
+             "theta in [P3]^2, PSRI degrees 6/4 (fem_reference/elements.py).", "",
              "Gold (data/fem_gold/dL0.5_W0.05/richardson.json, P2B3 on "
              + ", ".join(f"{a} x {c}" for a, c in ref["meshes"]) + "): "
              + "; ".join(f"{LABELS[q]} {ref[q]['value']:.5f} ± {ref[q]['error_bar']:.1e}"

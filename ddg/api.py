@@ -40,7 +40,8 @@ ROD_FAMILY = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-wun
 CENTERLINE_STATIONS = 101
 
 
-def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None, zeta: float | None = None):
+def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None, zeta: float | None = None,
+               membrane: str | None = None):
     """The model `name` of the strip at `resolution` (rod: nodes M; plate: target triangles).
 
     zeta (m): the regularisation length of the ribbon (Eq. A.5) and of the Wunderlich ribbon's
@@ -51,6 +52,15 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
     """
     cls = _model_class(name)
     resolution = check_resolution(name, resolution)
+    if membrane is not None:
+        if name != "plate-midedge":
+            raise InputError(f"membrane applies to the model 'plate-midedge' only, not {name!r}")
+        from .geometry.plate_mesh import PlateMesh
+
+        if mesh is not None and not isinstance(mesh, PlateMesh):
+            raise InputError(f"mesh = {mesh!r}: the mid-edge plate takes a PlateMesh from "
+                             "ddg.geometry.plate_mesh.ghost_clamp_mesh (no mesh files)")
+        return cls(strip, resolution, mesh=mesh, membrane=membrane)
     if zeta is not None:
         if name not in ("ribbon", "ribbon-wunderlich"):
             raise InputError(f"zeta applies to the models 'ribbon' and 'ribbon-wunderlich' only, not {name!r}")
@@ -227,6 +237,7 @@ def simulate(
     error_map=None,
     zeta: float | None = None,
     centerline: bool = True,
+    membrane: str | None = None,
 ) -> SimulationResult:
     """Run the two-stage protocol (compress by dL, then shear by dW) on one model.
 
@@ -258,6 +269,9 @@ def simulate(
     "ribbon-wunderlich"'s ruling slope (default the Sano-Wada value sqrt((1 - nu) / 60) W^2 / b);
     summary keys zeta, zeta_over_L. The ribbons with width ("ribbon-sano-wada", "ribbon-trapeze",
     "ribbon-wunderlich", ddg.models.wide_ribbons) run like the rod (resolution = nodes M).
+    membrane (model "plate-midedge" only): "psri" (default: alpha = b^2/h^2 of the constant-strain
+    triangles, the rest node-smoothed, against membrane locking) or "full" (constant-strain
+    triangles alone); ddg.models.midedge_plate.MEMBRANES, summary key membrane.
     centerline=False records no centerline (result.centerlines empty, no out/centerline.csv): for
     studies that read only path.csv and summary.json (the gold and mesh studies in data/).
     model="auto" with `tolerance` (units of L; `quantities` of dW1, dW2, H_mid, default all;
@@ -301,7 +315,7 @@ def simulate(
     if dynamic_options is not None:
         raise InputError("dynamic_options apply to solver='dynamic' only")
     branches = (model not in ("plate", "plate-midedge")) if branches is None else bool(branches)
-    instance = make_model(model, strip, resolution, mesh, zeta=zeta)
+    instance = make_model(model, strip, resolution, mesh, zeta=zeta, membrane=membrane)
     if frames and out is None:
         raise InputError("frames=True needs an output directory (out)")
     options = _checked_options(options)

@@ -206,7 +206,8 @@ def test_the_predicted_error_holds_on_three_held_out_scenes_made_after_the_rule(
     references 42 of 42 and 41)."""
     checked = _held_out_entries(em.HELD_OUT_SECOND)
     assert len(checked) == 3
-    assert all(e["held"] == e["compared"] > 0 for e in checked), [(e["scene"], e["held"], e["compared"]) for e in checked]
+    assert all(e["held"] == e["compared"] > 0 for e in checked), \
+        [(e["scene"], e["held"], e["compared"]) for e in checked]
     assert all(e["margin"] > 1.0 for e in checked)   # the cross-validated margin is in use
 
 

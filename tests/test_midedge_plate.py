@@ -179,6 +179,19 @@ def test_psri_weight_is_the_shells_b2_over_h2():
         MidedgePlateModel(s, rows=8, membrane="reduced")
 
 
+def test_simulate_takes_the_membrane_of_the_mid_edge_plate_only():
+    import ddg
+
+    s = strip()
+    protocol = ddg.LoadingProtocol(0.5)
+    with pytest.raises(InputError, match="membrane = 'cst' must be one of psri, full"):
+        ddg.simulate(s, protocol, model="plate-midedge", resolution=300, membrane="cst")
+    with pytest.raises(InputError, match="'plate-midedge' only, not 'plate'"):
+        ddg.simulate(s, protocol, model="plate", membrane="full")
+    model = ddg.api.make_model("plate-midedge", s, mesh=ghost_clamp_mesh(s.length, s.width, rows=4), membrane="full")
+    assert model.membrane == "full" and model.membrane_alpha == 1.0
+
+
 # ---------------------------------------------------------------------------- narrow-strip limit
 def clamp_rotation_energy(model, rotation):
     """Linear elastic energy of the flat strip when the moving clamp turns by `rotation` (a

@@ -42,7 +42,8 @@ MISSING = "\u2013"   # en dash: no data
 LEGEND = (
     "dW1/L and dW2/L are the clamp shears at the pitchfork (U -> US) and at the snap (US -> S) in units of "
     "L; W\u00b2/(bL) is the width squared over thickness times length (L/b = 1181.1). Each FEM (data/fem_gold), "
-    "plate (the paper's, data/plate_gold) and mid-edge plate (data/midedge_gold) value is the converged value of that model's mesh study of the scene, "
+    "plate (the paper's, data/plate_gold) and mid-edge plate (data/midedge_gold) value is the converged "
+    "value of that model's mesh study of the scene, "
     "\u00b1 its error bar: fem_reference.convergence.estimate, i.e. the Richardson extrapolation with the "
     "observed order and Roache's grid convergence index as error bar where the finest three meshes are in "
     "the asymptotic range (safety factor 1.25 at an observed order of 1.5 or more, 3 below), else the finest "

@@ -352,7 +352,8 @@ class Table:
 def _base(scene: ReferenceScene, model: str, resolution: int, label: str) -> dict:
     s = scene.actual_slenderness
     return {"scene": scene.name, "role": scene.role, "compression_ratio": scene.compression_ratio,
-            "width_ratio": scene.width_ratio, "slenderness": s, "width_squared_over_thickness_length": scene.width_ratio**2 * s, "model": model,
+            "width_ratio": scene.width_ratio, "slenderness": s,
+            "width_squared_over_thickness_length": scene.width_ratio**2 * s, "model": model,
             "resolution": resolution, "resolution_label": label, "reference": scene.reference_source,
             "reference_hash": scene.reference_hash}
 
@@ -772,7 +773,8 @@ def figures(rows: list[dict], out: Path, tolerance: float = 0.01) -> list[str]:
             ax.set_yscale("log")
             ax.set_xlabel("W/L", fontsize=8)
             ax.set_ylabel("L/b", fontsize=8)
-            ax.set_title(f"dL/L = {fraction_label(c)}: cheapest DDG model (else FEM mesh) within {tolerance:g} on {title}",
+            ax.set_title(f"dL/L = {fraction_label(c)}: cheapest DDG model (else FEM mesh) within {tolerance:g} "
+                         f"on {title}",
                          fontsize=7)
             ax.tick_params(labelsize=7)
     fig.tight_layout()

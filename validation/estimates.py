@@ -48,7 +48,8 @@ class Estimate:
 
 @dataclass(frozen=True)
 class Curve:
-    """A quantity (H_mid/L, or the clamp force F_shear L/(E b^3)) against dW/L with a pointwise error bar (arrays of equal length, dW increasing), and
+    """A quantity (H_mid/L, or the clamp force F_shear L/(E b^3)) against dW/L with a pointwise error bar
+    (arrays of equal length, dW increasing), and
     each point's observed order (nan where none) and whether its sequence was asymptotic."""
     dw: np.ndarray
     value: np.ndarray

@@ -231,7 +231,8 @@ def _shade_phases(ax, rows: list[dict], dw_max: list[tuple[float, float]]) -> No
     top = np.interp(w, *map(np.array, zip(*sorted(dw_max))))
     d2 = np.array([r["dW2_over_L"] if r["dW2_over_L"] is not None else t for r, t in zip(sel, top)])
     for (name, colour), (lo, hi) in zip(PHASE_SHADES, ((np.zeros_like(d1), d1), (d1, d2), (d2, top))):
-        ax.fill_between(w, lo, hi, color=colour, zorder=0, label=f"{name} ({'FEM' if model.startswith('fem') else model})")
+        label = f"{name} ({'FEM' if model.startswith('fem') else model})"
+        ax.fill_between(w, lo, hi, color=colour, zorder=0, label=label)
 
 
 def wide_ribbons(rows: list[dict], compressions: list[float]):
@@ -558,7 +559,8 @@ def sadowsky_a11(rows: list[dict]):
 
 DRAW = {"elastica": elastica, "centerline_error": centerline_error, "curvature_profiles": curvature_profiles,
         "sadowsky_a11": sadowsky_a11, "centerline_error_field": centerline_error_field,
-        "deformed_plates": deformed_plates, "shear_curves": shear_curves, "shear_force": shear_force, "thresholds": thresholds,
+        "deformed_plates": deformed_plates, "shear_curves": shear_curves, "shear_force": shear_force,
+        "thresholds": thresholds,
         "convergence": convergence, "poisson": poisson, "speed_accuracy": speed_accuracy,
         "stability_map": stability_map, "snapshots": snapshots, "wide_ribbons": wide_ribbons}
 

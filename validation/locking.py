@@ -16,7 +16,11 @@ threshold location: the U branch is what is compared).
 
 Each run is a folder OUT/Lb<L/b>/<membrane>_R<rows>/ (or fem_N64x8/) with path.csv and
 summary.json; a finished run is kept (resumable run by run, Ctrl-C keeps what finished).
-OUT/summary.json and OUT/locking.md tabulate them.
+OUT/summary.json and OUT/locking.md tabulate them, with any other shell run stored as
+OUT/Lb<L/b>/fem_N<along>x<across>/: the 96 x 12 check of the shell's membrane share at L/b = 1181
+was run to dW/L = 0.26 (`python -m fem_reference simulate --width-ratio 0.16666666666666666
+--compression-ratio 0.5 --shear-ratio 0.26 --shear-steps 44 --resolution 96 --across 12 --no-fields
+--no-centerline --no-thresholds --no-branch-switching --out OUT/Lb1181.1/fem_N96x12`).
 """
 from __future__ import annotations
 
@@ -52,20 +56,15 @@ def run_plate(slenderness: float, rows: int, membrane: str, target: Path) -> dic
     """One mid-edge plate run into `target` (kept if finished)."""
     import ddg
     from ddg.geometry.plate_mesh import ghost_clamp_mesh
-    from ddg.models.midedge_plate import MidedgePlateModel
 
     summary = finished_run_summary(target)
     if summary is not None:
         return summary
     strip = ddg.Strip.from_ratios(WIDTH_RATIO, COMPRESSION_RATIO, slenderness)
-    mesh = ghost_clamp_mesh(strip.length, strip.width, rows=rows)
-    model = MidedgePlateModel(strip, mesh=mesh, membrane=membrane)
     protocol = ddg.LoadingProtocol(COMPRESSION_RATIO, shear_ratio=SHEAR_RATIO, shear_steps=_steps(strip))
-    # ddg.simulate's static run with this model instance (simulate builds the default membrane)
-    from ddg.api import _checked_options, _static_run
-
-    return _static_run("plate-midedge", model, strip, protocol, None, _checked_options(None), target, False, True,
-                       False, centerline=False).summary
+    mesh = ghost_clamp_mesh(strip.length, strip.width, rows=rows)
+    return ddg.simulate(strip, protocol, model="plate-midedge", mesh=mesh, membrane=membrane, out=target,
+                        branches=False, centerline=False).summary
 
 
 def run_fem(slenderness: float, target: Path) -> dict | None:
@@ -103,7 +102,8 @@ def tabulate(out: Path) -> dict:
     entries = []
     for slenderness in SLENDERNESSES:
         folder = out / f"Lb{slenderness:g}"
-        names = [(m, r, f"{m}_R{r}") for m in MEMBRANES for r in ROWS] + [("fem", None, "fem_N%dx%d" % FEM_MESH)]
+        fem = sorted((p.name for p in folder.glob("fem_N*")), key=lambda n: int(n[5:].split("x")[0]))
+        names = [(m, r, f"{m}_R{r}") for m in MEMBRANES for r in ROWS] + [("fem", n[5:], n) for n in fem]
         for membrane, rows, name in names:
             if finished_run_summary(folder / name) is None:
                 continue
@@ -124,14 +124,18 @@ def tabulate(out: Path) -> dict:
              f"W/L = 1/6, dL/L = 1/2, path to dW/L = {SHEAR_RATIO}. Regenerate: `.venv/bin/python -m "
              f"validation.locking --out {out} --fem`. stretching share: stretching energy over the whole on the U "
              "branch at dW/L = " + ", ".join(f"{dw:g}" for dw in SHARE_AT) + ".", "",
-             "| L/b | model | membrane | rows | alpha | dW1/L | reached dW/L | share " + " | share ".join(f"{dw:g}" for dw in SHARE_AT)
+             "| L/b | model | membrane | rows | alpha | dW1/L | reached dW/L | share "
+             + " | share ".join(f"{dw:g}" for dw in SHARE_AT)
              + " | folds | Newton its | wall s | status |",
              "|---:|---|---|---:|---:|---:|---:|" + "---:|" * len(SHARE_AT) + "---:|---:|---:|---|"]
     for e in entries:
         shares = " | ".join(_fmt(v, "{:.4f}") for v in e["stretching_share"].values())
-        lines.append(f"| {e['slenderness']:g} | {e['model']} | {e['membrane']} | {e['rows'] or '64 x 8'} | "
-                     f"{_fmt(e['alpha'], '{:.2g}')} | {_fmt(e['dW1_over_L'])} | {_fmt(e['dW_last_over_L'])} | {shares} | {e['folds']} | "
+        lines.append(f"| {e['slenderness']:g} | {e['model']} | {e['membrane']} | {e['rows']} | "
+                     f"{_fmt(e['alpha'], '{:.2g}')} | {_fmt(e['dW1_over_L'])} | {_fmt(e['dW_last_over_L'])} | "
+                     f"{shares} | {e['folds']} | "
                      f"{e['newton_iterations']} | {_fmt(e['wall_time_s'], '{:.0f}')} | {e['status']} |")
+    lines += ["", "rows: rows of triangles across W (plate); elements along x across (shell)."]
+    lines += ["", "rows: rows of triangles across W (plate), elements along x across (shell)."]
     atomic_write_text(out / "locking.md", "\n".join(lines) + "\n")
     return summary
 

@@ -777,7 +777,8 @@ def wide_ribbon_table(rows: list[dict]) -> list[dict]:
         for r in picks:
             out.append({"compression_ratio": compression, "width_ratio": width, "model": r["model"],
                         "resolution": r["resolution_label"], "dW1_over_L": finite_float(r["dW1"]),
-                        "dW2_over_L": finite_float(r["dW2"]), "ref_dW1": finite_float(r["ref_dW1"]), "ref_dW2": finite_float(r["ref_dW2"]),
+                        "dW2_over_L": finite_float(r["dW2"]), "ref_dW1": finite_float(r["ref_dW1"]),
+                        "ref_dW2": finite_float(r["ref_dW2"]),
                         "dW1_error": finite_float(r["dW1_error"]), "dW2_error": finite_float(r["dW2_error"]),
                         "H_mid_error": finite_float(r["H_mid_error"]), "wall_time_s": finite_float(r["wall_time_s"]),
                         "reason": r.get("reason", "")})

@@ -13,9 +13,10 @@ COMPRESSIONS = (1 / 2, 1 / 4)
 WIDTHS_PHASE_DIAGRAM = (1 / 20, 1 / 16, 1 / 12, 1 / 10, 1 / 8, 1 / 6, 1 / 5, 1 / 4, 1 / 3, 1 / 2.5, 1 / 2)
 #: (dL/L, W/L) of the 3D snapshots (paper Fig. 1): a narrow and a wide plate; their plate runs keep frames
 SNAPSHOT_SCENES = ((1 / 2, 1 / 20), (1 / 2, 1 / 6))
+#: (dL/L, W/L) of the speed-accuracy chart (the FEM gold scene of the cross-model test)
 SPEED_SCENE = (1 / 2, 1 / 6)
 #: The 1D models with width (ddg.models.wide_ribbons), run like the rod at M = 101 on `wide_ribbon_scenes`.
-WIDE_RIBBONS = ("ribbon-sano-wada", "ribbon-trapeze", "ribbon-wunderlich")  # (dL/L, W/L) of the speed-accuracy chart (the FEM gold scene of the cross-model test)
+WIDE_RIBBONS = ("ribbon-sano-wada", "ribbon-trapeze", "ribbon-wunderlich")
 
 
 @dataclass

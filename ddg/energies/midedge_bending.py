@@ -226,7 +226,7 @@ def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT,
         t3[0, i] = X * dY[i] - Y * dX[i]
         t3[1, i] = 2.0 * X * dX[i] + 2.0 * Y * dY[i]
     for i in range(12):
-        gi, ci, dTi, dli, dXi, dYi = t3[0, i], t3[1, i], dT[i], dl[i], dX[i], dY[i]
+        gi, ci, dTi, dli = t3[0, i], t3[1, i], dT[i], dl[i]
         for k in range(i, 12):
             # Hessian of l = |e|: Je^T (I - e e^T / l^2) Je / l, nonzero on the (v0, v1) blocks
             hl = 0.0

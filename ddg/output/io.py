@@ -225,7 +225,8 @@ class PathTable:
             import pandas
         except ImportError:
             raise ImportError("to_dataframe needs pandas, which is not installed: pip install 'ddg-strips[dataframe]' "
-                              "(or apt install python3-pandas); result.arrays() gives numpy arrays without it") from None
+                              "(or apt install python3-pandas); result.arrays() gives numpy arrays without it") \
+                from None
         return pandas.DataFrame(self.arrays(stage))
 
 

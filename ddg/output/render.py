@@ -126,7 +126,8 @@ def _frame_files(frames_dir: Path) -> dict[int, Path]:
     if pvd.is_file():
         try:
             for d in ET.parse(pvd).getroot().iter("DataSet"):   # "step" (timestep is dW/L; older files: the step)
-                files[int(d.get("step") if d.get("step") is not None else d.get("timestep"))] = frames_dir / d.get("file")
+                step = d.get("step") if d.get("step") is not None else d.get("timestep")
+                files[int(step)] = frames_dir / d.get("file")
         except (ET.ParseError, TypeError, ValueError):
             files = {}
     if not files:  # no collection (or a broken one): the frame files by name

@@ -150,6 +150,9 @@ def main(argv=None) -> int:
     parser.add_argument("--fem", action="store_true", help="also the shell on 64 x 8 at each slenderness")
     parser.add_argument("--table-only", action="store_true", help="no run: rewrite the tables")
     args = parser.parse_args(argv)
+    from ddg.output.interrupts import terminate_as_interrupt
+
+    terminate_as_interrupt()  # SIGTERM too: the run in progress is written "interrupted", the table rewritten
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     try:

@@ -32,8 +32,34 @@ COARSE_DW1, MIDDLE_DW1, MIDDLE_DW2, LOWEST_ORDER = 0.008, 0.003, 0.005, 1.5
 #: An observed order above 4 is no order (the asymptotic window of fem_reference.convergence).
 HIGHEST_ORDER = 4.0
 
+#: Scenes whose mid-edge study has not been run yet (issue 29 item 3 in progress; resumable:
+#: `python -m validation.plate_gold --model plate-midedge --out data/midedge_gold --only NAME`).
+NOT_YET_RUN = [  # whose study is not complete on its three meshes
+    "dL0.5_W1/12", "dL0.5_W1/3", "dL0.25_W1/20", "dL0.25_W1/12", "dL0.25_W1/3", "dL0.25_W1/2"]
+
 #: Measured misses, filled in from the studies as they were run: {test id: reason with figures}.
-MISSES: dict[str, str] = {}
+MISSES: dict[str, str] = {
+    **{key: f"no complete mid-edge study of {name} stored yet (issue 29 item 3 in progress)"
+       for name in NOT_YET_RUN for key in (f"agree {name} dW1", f"agree {name} dW2", f"path {name}")},
+    "order W1/6": "issue 29 target not met: dL/L = 1/2, W/L = 1/6, dW1/L 0.2777/0.2710/0.2698 on 8/12/18 rows "
+                  "(differences -0.0067, -0.0012): observed order 4.21, outside [1.5, 4]; a 28-row run gives "
+                  "0.2681 (-0.0017 from 18 rows): not asymptotic",
+    "order W1/2": "issue 29 target not met: dL/L = 1/2, W/L = 1/2, dW1/L 0.1561/0.1578/0.1593 on 16/24/36 rows "
+                  "(rising, away from the FEM's 0.1566 +- 0.0008): observed order 0.50",
+    "coarse W1/6": "issue 29 target not met: dL/L = 1/2, W/L = 1/6, 8 rows dW1/L 0.2777, 0.0123 above the FEM's "
+                   "0.2654 (bound 0.008); 12 rows 0.2710, 0.0056 above (bound 0.003), dW2/L 0.4239, 0.0069 below "
+                   "0.4308 (bound 0.005)",
+    "coarse W1/2": "issue 29 target not met: dL/L = 1/2, W/L = 1/2, 16 rows dW1/L 0.1561 and 24 rows 0.1578 are "
+                   "within 0.008 and 0.003 of the FEM's 0.1566, but the 24-row dW2/L 0.3937 is 0.0526 above the "
+                   "FEM's 0.3411 (bound 0.005)",
+    "path dL0.5_W1/6": "issue 29 target not met: dL/L = 1/2, W/L = 1/6, 12 rows: U -> US -> S -> US -> S ... (9 "
+                       "phase changes, folds at dW/L 0.412, 0.424, 0.464, 0.536, 0.608 up to the last resolved "
+                       "state 0.638); 18 rows: U -> US -> S without a fold",
+    "path dL0.5_W1/2": "issue 29 target not met: dL/L = 1/2, W/L = 1/2, 24 rows: 14 folds from dW/L 0.279 up to the "
+                       "last resolved state 0.40; 36 rows: U -> US -> S -> US -> S, one fold (0.336)",
+    "path dL0.25_W1/6": "issue 29 target not met: dL/L = 1/4, W/L = 1/6, 12 rows: two folds at dW/L 0.261 and 0.262 "
+                        "(the snap to S taken in two); 18 rows: one fold (0.261)",
+}
 
 
 def _id(c, w):
@@ -57,6 +83,7 @@ def _study(model, c, w):
 @pytest.mark.parametrize("scene", SCENES, ids=[_id(*s) for s in SCENES])
 def test_midedge_and_fem_thresholds_agree_within_their_combined_error_bars(request, scene, quantity):
     _xfail_if_missed(request, f"agree {_id(*scene)} {quantity}")
+    assert len(_study("plate-midedge", *scene).meshes) >= 3, "a study rests on three meshes"
     fem, midedge = (getattr(_study(m, *scene), quantity) for m in ("fem", "plate-midedge"))
     assert fem is not None and midedge is not None, (fem, midedge)
     assert abs(midedge.value - fem.value) <= midedge.error_bar + fem.error_bar, (midedge, fem)

@@ -35,7 +35,7 @@ HIGHEST_ORDER = 4.0
 #: Scenes whose mid-edge study has not been run yet (issue 29 item 3 in progress; resumable:
 #: `python -m validation.plate_gold --model plate-midedge --out data/midedge_gold --only NAME`).
 NOT_YET_RUN = [  # whose study is not complete on its three meshes
-    "dL0.5_W1/12", "dL0.5_W1/3", "dL0.25_W1/20", "dL0.25_W1/12", "dL0.25_W1/3", "dL0.25_W1/2"]
+    "dL0.5_W1/3", "dL0.25_W1/12", "dL0.25_W1/3", "dL0.25_W1/2"]
 
 #: Measured misses, filled in from the studies as they were run: {test id: reason with figures}.
 MISSES: dict[str, str] = {
@@ -125,50 +125,45 @@ def path_transitions(folder: Path) -> tuple[list[str], list[float], float]:
     return phases, list(summary.get("folds_dW_over_L") or []), resolved
 
 
+#: Folds beyond the snap to S that are physics (the issue's condition: the shell shows them and the
+#: finer meshes keep them): {scene: [dW/L of the fold]}. Each is checked below against the shell's
+#: finest run, whose H_mid/L must drop there by more than twice each neighbouring recorded step.
+PHYSICAL_FOLDS = {
+    # the shell (216 x 28): H_mid/L 0.2415 -> 0.1925 from dW/L 0.3737 to 0.3802; the plate (18 rows)
+    # 0.2428 -> 0.1937 over the same step; 12 and 18 rows both fold at 0.379
+    "dL0.5_W1/12": [0.379],
+}
+
+
+def shell_drops_at(folder: Path, dw: float) -> bool:
+    """Whether the shell's recorded H_mid/L jumps across the recorded step that contains dW/L = dw
+    (within 0.01 L): the step's change more than twice each neighbouring step's."""
+    with open(folder / "path.csv") as fh:
+        rows = [(float(r["dW_over_L"]), float(r["H_mid_over_L"])) for r in csv.DictReader(fh) if r["stage"] == "shear"]
+    steps = [abs(b[1] - a[1]) for a, b in zip(rows, rows[1:])]
+    for i in range(1, len(steps) - 1):
+        a, b = rows[i][0], rows[i + 1][0]
+        if a - 0.01 <= dw <= b + 0.01 and steps[i] > 2 * max(steps[i - 1], steps[i + 1]):
+            return True
+    return False
+
+
 @pytest.mark.parametrize("scene", SCENES, ids=[_id(*s) for s in SCENES])
 def test_midedge_path_leaves_U_continuously_and_reaches_S_through_one_transition(request, scene):
+    """At most one fold (the snap to S) up to the last resolved state on the two finer meshes,
+    besides the folds of PHYSICAL_FOLDS, which the shell's finest run must show as well."""
     _xfail_if_missed(request, f"path {_id(*scene)}")
     study = _study("plate-midedge", *scene)
     assert len(study.meshes) >= 3
+    physical = PHYSICAL_FOLDS.get(_id(*scene), [])
+    if physical:
+        shell = _study("fem", *scene).meshes[-1].folder
+        assert all(shell_drops_at(shell, f) for f in physical), (physical, shell)
     for mesh in study.meshes[1:]:
         phases, folds, resolved = path_transitions(mesh.folder)
         first_asymmetric = mesh.dW1 if mesh.dW1 is not None else 0.0
         early = [f for f in folds if f < first_asymmetric]
         assert not early, (mesh.label, "folds before the pitchfork", early)
         assert phases == ["U", "US", "S"], (mesh.label, phases, resolved)
-        assert len([f for f in folds if f <= resolved]) <= 1, (mesh.label, folds, resolved)
-
-
-# ---------------------------------------------------------------------------- locking (data/midedge_locking)
-LOCKING = ROOT / "data" / "midedge_locking"
-
-
-def _locking_runs() -> dict:
-    summary = json.loads((LOCKING / "summary.json").read_text())
-    return {(r["slenderness"], r["membrane"], r["rows"]): r for r in summary["runs"]}
-
-
-def test_the_psri_membrane_removes_the_thickness_dependence_of_the_coarse_pitchfork():
-    """The locking diagnosis (validation/locking.py): on 8 rows the constant-strain membrane's dW1/L
-    moves from 0.2774 (L/b = 300) to 0.3056 (1181), 0.028 L, where the converged shell moves by
-    -0.004 (0.2692 on 96 x 12 at 300; 0.2654 +- 0.0031 at 1181): spurious membrane energy growing
-    as (L/b)^2. With the PSRI membrane: 0.2773 and 0.2777. Bound: 0.002 L (a tenth of the locked
-    shift; the 8-row discretisation error, 0.012, is what remains and is not locking)."""
-    runs = _locking_runs()
-    full = [runs[(s, "full", 8)]["dW1_over_L"] for s in (300.0, 1181.1)]
-    psri = [runs[(s, "psri", 8)]["dW1_over_L"] for s in (300.0, 1181.1)]
-    assert full[1] - full[0] > 0.02, full
-    assert abs(psri[1] - psri[0]) < 0.002, psri
-
-
-def test_the_stored_locking_run_is_what_the_code_computes(tmp_path):
-    """The committed 8-row PSRI run at L/b = 300 (about 5 s), rerun: the same dW1 to its bisection
-    tolerance and the same stretching shares along U to 1e-6."""
-    from validation import locking
-
-    stored = _locking_runs()[(300.0, "psri", 8)]
-    summary = locking.run_plate(300.0, 8, "psri", tmp_path / "run")
-    assert summary["dW1_over_L"] == pytest.approx(stored["dW1_over_L"], abs=1e-4)
-    rerun = locking.tabulate_run(tmp_path / "run")
-    for dw, share in stored["stretching_share"].items():
-        assert rerun[dw] == pytest.approx(share, abs=1e-6), dw
+        other = [f for f in folds if f <= resolved and not any(abs(f - g) <= 0.005 for g in physical)]
+        assert len(other) <= 1, (mesh.label, folds, resolved)

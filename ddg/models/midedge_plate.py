@@ -7,8 +7,9 @@ material (Young's modulus E, Poisson ratio nu for both membrane and bending):
 
 - membrane: constant-strain triangles (ddg.energies.membrane), plane-stress St Venant-Kirchhoff,
   by default mixed as the shell's partial selective reduced integration: alpha = b^2 / h^2 of
-  them and 1 - alpha of their node-smoothed strains (ddg.energies.smoothed_membrane), which
-  removes the membrane locking of coarse thin meshes (issue 29; `membrane="full"`: all CST);
+  them and 1 - alpha of their node-smoothed strains (ddg.energies.smoothed_membrane), against
+  membrane locking: on 8 rows it removes the pitchfork's thickness dependence between L/b = 300
+  and 1181, not at 4000 (issue 29, data/midedge_locking; `membrane="full"`: all CST);
 - bending: mid-edge normals (ddg.energies.midedge_bending): one angle DOF per edge, the
   triangle's second fundamental form from its three mid-edge normals (Morley's element when
   linearised), density D/2 [nu tr(M)^2 + (1 - nu) tr(M^2)] with D = E b^3 / (12 (1 - nu^2)).
@@ -120,6 +121,7 @@ class MidedgePlateModel(PlateModel):
         self._plane_stress = plane_stress_matrix(E, b, nu)
         #: share of the full constant-strain membrane; the rest is the node-smoothed one
         self.membrane_alpha = min(1.0, (b / self._typical_spacing()) ** 2) if membrane == "psri" else 1.0
+        self._membrane_full = self.membrane_alpha * self._membrane
         self._triangles = np.ascontiguousarray(tris, dtype=np.int64)
         self._face_edges = np.ascontiguousarray(face_edges, dtype=np.int64)
         self._roles = np.ascontiguousarray(roles, dtype=np.int64)
@@ -133,6 +135,12 @@ class MidedgePlateModel(PlateModel):
         stencil = np.concatenate([self.node_dofs[tris].reshape(len(tris), -1),
                                   self.node_dofs[far].reshape(len(tris), -1), self.edge_dofs[face_edges]], axis=1)
         self.bandwidth = int((stencil.max(axis=1) - stencil.min(axis=1)).max())
+        # the smoothed membrane couples the nodes of each patch (the triangles around a node)
+        pointer, patch_faces = self._patches[0], self._patches[1]
+        patch_dofs = self.node_dofs[tris[patch_faces]].reshape(len(patch_faces), -1)
+        starts = pointer[:-1]
+        span = np.maximum.reduceat(patch_dofs.max(axis=1), starts) - np.minimum.reduceat(patch_dofs.min(axis=1), starts)
+        self.bandwidth = max(self.bandwidth, int(span.max()))
 
         self.rest_edge_lengths = np.linalg.norm(nodes[edges[:, 1]] - nodes[edges[:, 0]], axis=1)
         self.stretch_stiffness = E * b * mesh.edge_triangle_areas / self.rest_edge_lengths**2 / (1.0 - nu * nu)
@@ -149,7 +157,7 @@ class MidedgePlateModel(PlateModel):
         n = self.n_dof
         grad, band = self._accumulators(gradient, hessian)
         alpha = self.membrane_alpha
-        stretching = add_membrane_terms(x, self._triangles, alpha * self._membrane, self._abar, self._node_dofs, n,
+        stretching = add_membrane_terms(x, self._triangles, self._membrane_full, self._abar, self._node_dofs, n,
                                         grad, band, gradient, hessian)
         if alpha < 1.0:
             stretching += add_smoothed_membrane_terms(x, self._triangles, self._strain_T, self._abar, *self._patches,

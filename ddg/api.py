@@ -52,15 +52,9 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
     """
     cls = _model_class(name)
     resolution = check_resolution(name, resolution)
-    if membrane is not None:
-        if name != "plate-midedge":
-            raise InputError(f"membrane applies to the model 'plate-midedge' only, not {name!r}")
-        from .geometry.plate_mesh import PlateMesh
-
-        if mesh is not None and not isinstance(mesh, PlateMesh):
-            raise InputError(f"mesh = {mesh!r}: the mid-edge plate takes a PlateMesh from "
-                             "ddg.geometry.plate_mesh.ghost_clamp_mesh (no mesh files)")
-        return cls(strip, resolution, mesh=mesh, membrane=membrane)
+    if membrane is not None and name != "plate-midedge":
+        raise InputError(f"membrane applies to the model 'plate-midedge' only, not {name!r}")
+    extra = {"membrane": membrane} if membrane is not None else {}
     if zeta is not None:
         if name not in ("ribbon", "ribbon-wunderlich"):
             raise InputError(f"zeta applies to the models 'ribbon' and 'ribbon-wunderlich' only, not {name!r}")
@@ -68,7 +62,7 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
             raise InputError(f"a mesh is used by the plate models only, not {name!r}")
         return cls(strip, resolution, zeta=zeta)
     if mesh is None:
-        return cls(strip, resolution)
+        return cls(strip, resolution, **extra)
     if name not in ("plate", "plate-midedge"):
         raise InputError(f"a mesh is used by the plate models only, not {name!r}")
     from .geometry.plate_mesh import PlateMesh
@@ -77,7 +71,7 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
         if not isinstance(mesh, PlateMesh):
             raise InputError(f"mesh = {mesh!r}: the mid-edge plate takes a PlateMesh from "
                              "ddg.geometry.plate_mesh.ghost_clamp_mesh (no mesh files)")
-        return cls(strip, mesh=mesh)
+        return cls(strip, mesh=mesh, **extra)
 
     if not isinstance(mesh, (PlateMesh, str, os.PathLike)) or isinstance(mesh, bool):
         raise InputError(f"mesh = {mesh!r} must be a PlateMesh, a mesh file path or 'gmsh'")

@@ -278,13 +278,14 @@ class Observer:
         if len(values):
             lam, mode = float(values[0]), vectors[0]
         compression, shear = m.clamp
+        energy = m.energy()
         row = {
             "stage": stage,
             "dL_over_L": compression,
             "dW_over_L": shear,
             "H_mid_over_L": float(pos[m.centre_node, 2]),
             "F_shear_norm": float(force[1]),
-            "energy": m.energy() * self.energy_unit,
+            "energy": energy * self.energy_unit,
             "lambda_min": lam,
             "phase": phase,
             "F_axial_norm": -float(force[0]),
@@ -293,7 +294,7 @@ class Observer:
             "branch_switched": bool(switched),
             **m.resolution_indicators(),
             "negative_eigenvalues": int(negative),
-            "stretching_share": m.stretching_share(),
+            "stretching_share": m.membrane_energy() / energy if energy > 0.0 else 0.0,
             "half_turn_defect_over_L": mirror,
             "point_reflection_defect_over_L": point,
             "wall_time_s": wall,

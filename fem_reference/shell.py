@@ -311,10 +311,9 @@ class NaghdiStrip:
         """Pi in units of D (multiply by E b^3 / 12 for J)."""
         return float(fem.assemble_scalar(self.energy_form))
 
-    def stretching_share(self) -> float:
-        """Membrane energy (its PSRI mix, as in the energy) over the whole energy; 0 unloaded."""
-        total = self.energy()
-        return float(fem.assemble_scalar(self.membrane_energy_form)) / total if total > 0.0 else 0.0
+    def membrane_energy(self) -> float:
+        """The membrane part of Pi (its PSRI mix, as in the energy), units of D."""
+        return float(fem.assemble_scalar(self.membrane_energy_form))
 
     def clamp_reaction(self) -> np.ndarray:
         """Force the moving clamp applies to the strip, units of D / L (sum of the residual over

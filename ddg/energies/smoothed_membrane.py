@@ -37,8 +37,9 @@ from ..solve.band_scatter import add_symmetric_block
 _S = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]]])
 
 
-def strain_maps(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(T (F, 3, 3), abar (F, 3), area (F,)): eps_f (Voigt, global reference axes) = T_f delta_f."""
+def strain_maps(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(T (F, 3, 3), area (F,)): eps_f (Voigt, global reference axes) = T_f delta_f, delta_f the
+    change of the metric of ddg.energies.membrane.face_membrane_matrices."""
     p = nodes[triangles]
     e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
     area = 0.5 * (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
@@ -46,12 +47,10 @@ def strain_maps(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, n
     Rinv = np.linalg.inv(R)
     eps = 0.5 * np.einsum("tia,kij,tjb->tkab", Rinv, _S, Rinv)  # (F, k, 2, 2)
     T = np.stack([eps[:, :, 0, 0], eps[:, :, 0, 1], eps[:, :, 1, 1]], axis=1)  # (F, voigt, k)
-    abar = np.stack([np.einsum("ti,ti->t", e1, e1), np.einsum("ti,ti->t", e1, e2), np.einsum("ti,ti->t", e2, e2)],
-                    axis=1)
-    return np.ascontiguousarray(T), abar, area
+    return np.ascontiguousarray(T), area
 
 
-def node_patches(triangles: np.ndarray, area: np.ndarray, n_nodes: int, active: np.ndarray | None = None):
+def node_patches(triangles: np.ndarray, area: np.ndarray, active: np.ndarray | None = None):
     """Node patches of the `active` triangles (default all): (pointer (P + 1,), patch triangles,
     weights w_Pf, patch areas A_P), one patch per node that an active triangle touches."""
     active = np.ones(len(triangles), dtype=bool) if active is None else np.asarray(active, dtype=bool)
@@ -60,12 +59,11 @@ def node_patches(triangles: np.ndarray, area: np.ndarray, n_nodes: int, active: 
     face = np.repeat(faces, 3)
     order = np.argsort(node, kind="stable")
     node, face = node[order], face[order]
-    used, start = np.unique(node, return_index=True)
+    _, start = np.unique(node, return_index=True)
     pointer = np.r_[start, len(node)].astype(np.int64)
     share = area[face] / 3.0
     patch_area = np.add.reduceat(share, start)
     weights = share / np.repeat(patch_area, np.diff(pointer))
-    assert len(used) <= n_nodes
     return pointer, face.astype(np.int64), weights, patch_area
 
 

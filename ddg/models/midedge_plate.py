@@ -116,12 +116,12 @@ class MidedgePlateModel(PlateModel):
         E, b, nu = strip.young_modulus, strip.thickness, strip.poisson_ratio
         self._membrane, self._abar = face_membrane_matrices(nodes, tris, E, b, nu)
         self._bending = face_bending_matrices(nodes, tris, E, b, nu)
-        self._strain_T, _, areas = strain_maps(nodes, tris)
-        self._patches = node_patches(tris, areas, n_nodes, active=~rigid)
+        self._strain_T, areas = strain_maps(nodes, tris)
+        self._patches = node_patches(tris, areas, active=~rigid)
         self._plane_stress = plane_stress_matrix(E, b, nu)
         #: share of the full constant-strain membrane; the rest is the node-smoothed one
         self.membrane_alpha = min(1.0, (b / self._typical_spacing()) ** 2) if membrane == "psri" else 1.0
-        self._membrane_full = self.membrane_alpha * self._membrane
+        self._membrane_share = self.membrane_alpha * self._membrane
         self._triangles = np.ascontiguousarray(tris, dtype=np.int64)
         self._face_edges = np.ascontiguousarray(face_edges, dtype=np.int64)
         self._roles = np.ascontiguousarray(roles, dtype=np.int64)
@@ -157,7 +157,7 @@ class MidedgePlateModel(PlateModel):
         n = self.n_dof
         grad, band = self._accumulators(gradient, hessian)
         alpha = self.membrane_alpha
-        stretching = add_membrane_terms(x, self._triangles, self._membrane_full, self._abar, self._node_dofs, n,
+        stretching = add_membrane_terms(x, self._triangles, self._membrane_share, self._abar, self._node_dofs, n,
                                         grad, band, gradient, hessian)
         if alpha < 1.0:
             stretching += add_smoothed_membrane_terms(x, self._triangles, self._strain_T, self._abar, *self._patches,

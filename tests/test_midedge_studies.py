@@ -172,3 +172,23 @@ def test_midedge_path_leaves_U_continuously_and_reaches_S_through_one_transition
         assert phases == ["U", "US", "S"], (mesh.label, phases, resolved)
         other = [f for f in folds if f <= resolved and not any(abs(f - g) <= 0.005 for g in physical)]
         assert len(other) <= 1, (mesh.label, folds, resolved)
+
+
+#: Issue 29's speed targets, as benchmarks/plate_path.py --model plate-midedge --rows 8 12 --repeat 3
+#: measured them (benchmarks/results/midedge_path.json: best of 3 warm calls, idle machine, load
+#: average 0.95-1.0, OpenBLAS on one thread). A test reads the stored benchmark; it times nothing.
+SPEED_MISS = ("issue 29 target not met: W/L = 1/6, dL/L = 1/2, full path with thresholds: 8 rows 30.11 s "
+              "(target 8 s), 12 rows 74.22 s (target 20 s); 15.47 and 14.75 Newton iterations per recorded step "
+              "(target 6): of the 2491 iterations on 8 rows, 676 are in failed solves, 431 in fold snaps and 224 "
+              "in branch switching (14 branch switches along the path)")
+
+
+@pytest.mark.xfail(strict=True, reason=SPEED_MISS)
+def test_midedge_plate_meets_the_issues_speed_targets_in_the_stored_benchmark():
+    stored = json.loads((ROOT / "benchmarks" / "results" / "midedge_path.json").read_text())
+    targets = {t["rows"]: t for t in stored["targets"]}
+    assert set(targets) == {8, 12}, sorted(targets)
+    for rows, t in targets.items():
+        assert t["completed"], (rows, t)
+        assert t["wall_time_s"] <= t["wall_target_s"] == {8: 8.0, 12: 20.0}[rows], (rows, t)
+        assert t["iterations_per_step"] <= t["iterations_per_step_target"] == 6.0, (rows, t)

@@ -292,7 +292,9 @@ def study_comparison(entry: Entry, record: dict, roots: dict | None = None) -> d
     folder = root / scene() / entry.folder
     stored = read_json_object(folder / "summary.json")
     brackets = bisection_brackets(entry.model)
-    out = {"study_run": str(folder), "study_run_found": stored is not None,
+    repo = Path(__file__).resolve().parents[1]
+    shown = folder.resolve().relative_to(repo) if folder.resolve().is_relative_to(repo) else folder
+    out = {"study_run": str(shown), "study_run_found": stored is not None,
            "study_status": None if stored is None else stored.get("status"),
            "study_wall_time_s": None if stored is None else stored.get("wall_time_s")}
     for key in THRESHOLDS:

@@ -123,8 +123,15 @@ class Study:
                 return None
             return abs(ours - estimate.value) + estimate.error_bar
         run = self.runs[k] if k < len(self.runs) else (StoredRun(mesh.folder) if mesh.folder else None)
+        return self.curve_error(run, key, band) if run is not None else None
+
+    def curve_error(self, run, key: str = "curve", band: float = 0.02, with_bar: bool = True) -> float | None:
+        """The largest distance of `run`'s (any stored run's) H_mid/L curve ("curve") or clamp force
+        ("force": relative to the largest |F| there) to this study's converged one, over the
+        converged curve's points `band` away from both converged thresholds and within the run's
+        reach, plus the converged value's error bar there (with_bar); None without a curve."""
         curve, column = (self.force, "F_shear_norm") if key == "force" else (self.curve, "H_mid_over_L")
-        if run is None or curve is None:
+        if curve is None:
             return None
         rows = [r for r in run.rows if r["stage"] == "shear"]
         dw, h = np.array([r["dW_over_L"] for r in rows]), np.array([r[column] for r in rows], float)
@@ -134,7 +141,8 @@ class Study:
         order = np.argsort(dw)
         diff = np.abs(np.interp(curve.dw[keep], dw[order], h[order]) - curve.value[keep])
         scale = float(np.max(np.abs(curve.value[keep]))) if key == "force" else 1.0   # the force: relative
-        return float(np.max(diff + curve.error_bar[keep])) / scale if scale > 0 else None
+        worst = diff + curve.error_bar[keep] if with_bar else diff
+        return float(np.max(worst)) / scale if scale > 0 else None
 
     def u_branch_orders(self, start: float = 0.05, band: float = 0.02) -> tuple[np.ndarray, int]:
         """Observed orders of H_mid at the asymptotic points of the U branch (start < dW/L < dW1 -

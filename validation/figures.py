@@ -13,7 +13,7 @@ import numpy as np
 
 from .report_data import FigureData, fraction
 
-COLORS = {"rod": "tab:blue", "plate": "tab:orange", "ribbon": "tab:green", "fem": "black",
+COLORS = {"rod": "tab:blue", "plate": "tab:orange", "plate-midedge": "tab:red", "ribbon": "tab:green", "fem": "black",
           "ribbon-sano-wada": "tab:olive", "ribbon-trapeze": "tab:purple", "ribbon-wunderlich": "tab:brown",
           "fem (extrapolated)": "black", "fem (converged)": "black", "plate (converged)": "tab:orange"}
 STABILITY_CATEGORIES = ["ok", "ok (mesh unresolved near dW_max)", "missed pitchfork", "dW1 unresolved by the mesh",
@@ -48,8 +48,8 @@ def pareto(points: list[tuple[float, float]]) -> list[int]:
 
 
 # ---------------------------------------------------------------------------- one function per kind
-MARKERS = {"rod": "o", "plate": "s", "ribbon": "^", "fem": "D", "ribbon-sano-wada": "v", "ribbon-trapeze": "P",
-           "ribbon-wunderlich": "X"}
+MARKERS = {"rod": "o", "plate": "s", "plate-midedge": "h", "ribbon": "^", "fem": "D", "ribbon-sano-wada": "v",
+           "ribbon-trapeze": "P", "ribbon-wunderlich": "X"}
 
 
 def elastica(rows: list[dict], exact: list[tuple[float, float]]):
@@ -312,12 +312,15 @@ def speed_accuracy(rows: list[dict], reference: str):
                            (axes[1], "dW1_error", "|dW1 error| / L")):
         pts = [(d["wall_time_s"], d[key], d) for d in rows if d[key] and d["wall_time_s"]]
         for model in sorted({p[2]["model"] for p in pts}):
-            sel = sorted((p for p in pts if p[2]["model"] == model), key=lambda p: p[2]["resolution"])
-            ax.loglog([p[0] for p in sel], [p[1] for p in sel], MARKERS.get(model, "o") + "-",
-                      color=COLORS.get(model, "gray"), label=model)
+            # by wall time: a mesh sequence's order (resolutions may be labels such as "96x12")
+            sel = sorted((p for p in pts if p[2]["model"] == model), key=lambda p: p[0])
+            base = model.removesuffix(" (benchmark)")   # the benchmark's entries: the model's colour, stars
+            marker = "*" if base != model else MARKERS.get(model, "o")
+            color = COLORS.get(base, "gray")
+            ax.loglog([p[0] for p in sel], [p[1] for p in sel], marker + "-", color=color, label=model)
             for k, p in enumerate(sel):   # alternate above / below the point so neighbours do not overlap
                 ax.annotate(str(p[2]["resolution"]), (p[0], p[1]), xytext=(4, 5 if k % 2 == 0 else -9),
-                            textcoords="offset points", fontsize=6, color=COLORS.get(model, "gray"))
+                            textcoords="offset points", fontsize=6, color=color)
         front = pareto([(p[0], p[1]) for p in pts])
         if front:
             fp = sorted((pts[i][0], pts[i][1]) for i in front)
@@ -325,8 +328,8 @@ def speed_accuracy(rows: list[dict], reference: str):
         ax.set_xlabel("wall time of the full path (s)")
         ax.set_ylabel(label)
         ax.legend(fontsize=7)
-    fig.suptitle(f"W/L = 1/6, dL/L = 1/2; reference: {reference}\nwall times as the report's runs measured them "
-                 "(labels: resolution)", fontsize=8)
+    fig.suptitle(f"W/L = 1/6, dL/L = 1/2; reference: {reference}\nwall times as each run measured them ("
+                 "'(benchmark)': benchmarks/speed_accuracy.py, idle machine; labels: resolution or rows)", fontsize=7)
     fig.tight_layout()
     return fig
 

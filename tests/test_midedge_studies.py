@@ -193,3 +193,18 @@ def test_midedge_plate_meets_the_issues_speed_targets_in_the_stored_benchmark():
         assert t["completed"], (rows, t)
         assert t["wall_time_s"] <= t["wall_target_s"] == {8: 8.0, 12: 20.0}[rows], (rows, t)
         assert t["iterations_per_step"] <= t["iterations_per_step_target"] == 6.0, (rows, t)
+
+
+SPEEDUP_MISS = ("issue 29 target not met (benchmarks/results/speed_accuracy.md, W/L = 1/6, dL/L = 1/2, idle machine): "
+                "the cheapest mid-edge run within 0.003 L of the FEM's converged dW1/L (0.2654 +- 0.0031) is 28 rows, "
+                "711.8 s (error 0.0027); the FEM's is 96 x 12, 175.2 s (error 0.0017): FEM time / mid-edge time 0.25 "
+                "against the 10 asked; the verdict by the benchmark's rule is 'undecided' because the reference's "
+                "own bar (0.00306) exceeds the 0.003 compared at")
+
+
+@pytest.mark.xfail(strict=True, reason=SPEEDUP_MISS)
+def test_midedge_plate_is_ten_times_faster_than_the_fem_at_equal_dW1_error_in_the_stored_benchmark():
+    stored = json.loads((ROOT / "benchmarks" / "results" / "speed_accuracy.json").read_text())
+    rule = stored["rule"]
+    assert rule["target_dW1_error_over_L"] == 0.003 and rule["target_speedup"] == 10.0, rule
+    assert stored["verdict"]["verdict"] == "met", stored["verdict"]

@@ -317,7 +317,11 @@ def speed_accuracy(rows: list[dict], reference: str):
             base = model.removesuffix(" (benchmark)")   # the benchmark's entries: the model's colour, stars
             marker = "*" if base != model else MARKERS.get(model, "o")
             color = COLORS.get(base, "gray")
-            ax.loglog([p[0] for p in sel], [p[1] for p in sel], marker + "-", color=color, label=model)
+            # one line through a mesh sequence; the shell's stored meshes (several series, labels such
+            # as "96x12", their studies' wall times) as points
+            joined = base != model or all(isinstance(p[2]["resolution"], (int, float)) for p in sel)
+            ax.loglog([p[0] for p in sel], [p[1] for p in sel], marker + ("-" if joined else ""), color=color,
+                      label=model)
             for k, p in enumerate(sel):   # alternate above / below the point so neighbours do not overlap
                 ax.annotate(str(p[2]["resolution"]), (p[0], p[1]), xytext=(4, 5 if k % 2 == 0 else -9),
                             textcoords="offset points", fontsize=6, color=color)

@@ -466,13 +466,13 @@ def speed_accuracy(results, study_specs, golds, benchmark: Path = SPEED_BENCHMAR
                     f"{converged.dW1.error_bar:.4f}; H_mid/L curve bars up to {bars:.1e}")
     elif gold is not None:
         reference = gold
-        ref_name = f"FEM gold ({gold.summary['scene']['resolution']} elements along L; no converged study)"
+        ref_name = f"the FEM gold ({gold.summary['scene']['resolution']} elements along L; no converged study)"
     else:
         if not runs:
             return [], "none"
         plates = [(s, r) for s, r in runs if s.model == "plate"] or runs
         spec, reference = max(plates, key=lambda t: t[0].resolution)
-        ref_name = f"finest {spec.model} run (resolution {spec.resolution}; no FEM gold data for this scene)"
+        ref_name = f"the finest {spec.model} run (resolution {spec.resolution}; no FEM gold data for this scene)"
 
     def errors(run, summary: dict) -> tuple:
         if converged is None:
@@ -964,8 +964,11 @@ def collect(profile: Profile, study: dict, results: dict, gold_root: Path | None
     figures.append(_records_figure(
         "speed_accuracy", "speed_accuracy",
         "Speed against accuracy: each model and resolution, wall time of the full path (thresholds included) "
-        f"against its error relative to the {ref_name}; dashed: the Pareto front. The wall times are as the report's "
-        "runs measured them: with --jobs N, N runs share the cores (README: how the committed snapshot was made).",
+        f"against its error relative to {ref_name}; dashed: the Pareto front. The wall times are as the report's "
+        "runs measured them: with --jobs N, N runs share the cores (README: how the committed snapshot was made). "
+        "Also shown: the shell's stored meshes (fem, points; their studies' wall times, measured beside other runs) "
+        "and the runs of benchmarks/speed_accuracy.py ('(benchmark)', stars: both plates and the shell on the "
+        "studies' meshes, one at a time on an idle machine).",
         speed, {"reference": ref_name}))
     smap = stability_map(results, golds, thresholds)
     figures.append(_records_figure("stability_map", "stability_map",

@@ -515,3 +515,30 @@ def test_equilateral_mesh_is_exactly_equilateral_between_its_end_strips(width, t
     # (the edge rows hold the half-size triangles: those with a node on y = +-W/2 are left out)
     interior = inside & np.all(np.abs(p[:, :, 1]) < 0.5 * width - 0.4 * width / n_y, axis=1)
     assert np.allclose(sides[interior], width / n_y, rtol=1e-9)
+
+
+@pytest.mark.parametrize("rows, columns", [(4, 12), (8, 40), (6, 2)])
+def test_ghost_clamp_mesh_with_given_columns_spaces_them_evenly_along_L(rows, columns):
+    """An anisotropic ghost-clamp mesh: `columns` element columns in [0, L] (one ghost column
+    beyond each clamp), `rows` rows across W, the centre a node, the area exactly L W inside."""
+    from ddg.geometry.plate_mesh import ghost_clamp_mesh
+
+    length, width = 0.15, 0.05
+    mesh = ghost_clamp_mesh(length, width, rows=rows, columns=columns)
+    xs = np.unique(np.round(mesh.nodes[:, 0] / (length / columns), 9))
+    assert xs.min() == -1 and xs.max() == columns + 1 and np.allclose(xs, np.round(xs))
+    assert np.any(np.all(np.isclose(mesh.nodes, [length / 2, 0.0]), axis=1))
+    inside = mesh.triangles[np.all((mesh.nodes[mesh.triangles, 0] >= -1e-12)
+                                   & (mesh.nodes[mesh.triangles, 0] <= length + 1e-12), axis=1)]
+    p = mesh.nodes[inside]
+    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                        - (p[:, 2, 0] - p[:, 0, 0]) * (p[:, 1, 1] - p[:, 0, 1]))
+    assert area.sum() == pytest.approx(length * width, rel=1e-12)
+
+
+@pytest.mark.parametrize("columns, word", [(7, "odd"), (0, "columns"), (2.5, "columns")])
+def test_ghost_clamp_mesh_refuses_bad_columns(columns, word):
+    from ddg.geometry.plate_mesh import ghost_clamp_mesh
+
+    with pytest.raises(InputError, match=word):
+        ghost_clamp_mesh(0.15, 0.05, rows=4, columns=columns)

@@ -2,19 +2,21 @@
 (issue 29, item 3: "where they disagree, find which side is wrong").
 
 `python -m validation.wide_check --out data/midedge_wide [--rows 16 24 36 54] [--membranes psri full]
-[--table-only]`
+[--no-anisotropic] [--table-only]`
 
 At dL/L = 1/4, W/L = 1/2 (L/b = 1181) the mid-edge plate's dW1/L (0.0858/0.0874/0.0872 on 16/24/36
 rows) stays about 0.002 L above the FEM's converged 0.0853 +- 0.0002. This study follows the
 mid-edge plate with both membranes (ddg.models.midedge_plate.MEMBRANES) on ghost-clamp meshes of
-ROWS rows to dW/L = SHEAR_RATIO (past dW1, at the default's recorded-step density: 48 steps),
-dW1 located, and tabulates, beside the FEM gold study's meshes (data/fem_gold/dL0.25_W0.5,
-read, not run), the U branch's clamp shear force F L/(E b^3) and H_mid/L at dW/L = AT (linear
-interpolation between recorded steps), the compressed H_mid/L against the exact elastica, and dW1/L.
+ROWS rows, and with the PSRI membrane on the ANISOTROPIC meshes (rows x element columns along L:
+is it the resolution along L or across W that the plate lacks?), to dW/L = SHEAR_RATIO (past
+dW1, at the default's recorded-step density: 48 steps), dW1 located. It tabulates, beside the FEM
+gold study's meshes (data/fem_gold/dL0.25_W0.5, read, not run), the U branch's clamp shear force
+F L/(E b^3) and H_mid/L at dW/L = AT (linear interpolation between recorded steps), the compressed
+H_mid/L against the exact elastica, and dW1/L.
 
-Each run is a folder OUT/<membrane>_R<rows>/ (path.csv, summary.json); a finished run is kept
-(resumable run by run; Ctrl-C keeps what finished). OUT/summary.json and OUT/wide_check.md hold
-the table.
+Each run is a folder OUT/<membrane>_R<rows>/ or OUT/psri_R<rows>_C<columns>/ (path.csv,
+summary.json); a finished run is kept (resumable run by run; Ctrl-C keeps what finished).
+OUT/summary.json and OUT/wide_check.md hold the table.
 """
 from __future__ import annotations
 
@@ -28,6 +30,9 @@ from ddg.output.io import atomic_write_text, finished_run_summary
 
 WIDTH_RATIO, COMPRESSION_RATIO = 1 / 2, 1 / 4
 ROWS = (16, 24, 36, 54)
+#: (rows across W, element columns along L) of the anisotropic meshes; the default ghost-clamp mesh
+#: has 36, 54, 84 and 124 columns on 16, 24, 36 and 54 rows (h_x nearest sqrt(3)/2 h_y)
+ANISOTROPIC = ((12, 72), (16, 72), (24, 108))
 MEMBRANES = ("psri", "full")
 SHEAR_RATIO = 0.2
 SHEAR_STEPS = 48
@@ -37,8 +42,9 @@ FEM_SCENE = "dL0.25_W0.5"
 ROOT_FEM = Path(__file__).resolve().parents[1] / "data" / "fem_gold"
 
 
-def run_plate(rows: int, membrane: str, target: Path) -> dict:
-    """One mid-edge plate run into `target` (kept if finished)."""
+def run_plate(rows: int, membrane: str, target: Path, columns: int | None = None) -> dict:
+    """One mid-edge plate run into `target` (kept if finished); `columns` element columns along L,
+    or the default ghost-clamp mesh's."""
     import ddg
     from ddg.geometry.plate_mesh import ghost_clamp_mesh
 
@@ -48,7 +54,7 @@ def run_plate(rows: int, membrane: str, target: Path) -> dict:
     strip = ddg.Strip.from_ratios(WIDTH_RATIO, COMPRESSION_RATIO)
     protocol = ddg.LoadingProtocol(COMPRESSION_RATIO, SHEAR_RATIO, compression_steps=40, shear_steps=SHEAR_STEPS)
     return ddg.simulate(strip, protocol, model="plate-midedge", mesh=ghost_clamp_mesh(strip.length, strip.width,
-                                                                                      rows=rows),
+                                                                                      rows=rows, columns=columns),
                         membrane=membrane, out=target, branches=False, centerline=False).summary
 
 
@@ -78,10 +84,16 @@ def write_tables(out: Path, fem_root: Path) -> dict:
     for folder in sorted((fem_root / FEM_SCENE).glob("N*/summary.json")):
         rows.append(row_of(f"fem {folder.parent.name}", folder.parent))
     rows.sort(key=lambda r: (r["triangles"] or 0))
+    def size(name: str) -> tuple[int, int]:   # psri_R16 -> (16, 0), psri_R16_C72 -> (16, 72)
+        parts = name.split("_")[1:]
+        return int(parts[0][1:]), int(parts[1][1:]) if len(parts) > 1 else 0
+
     for membrane in MEMBRANES:
-        for folder in sorted(out.glob(f"{membrane}_R*/summary.json"), key=lambda p: int(p.parent.name.split("_R")[1])):
+        for folder in sorted(out.glob(f"{membrane}_R*/summary.json"), key=lambda p: size(p.parent.name)):
             if finished_run_summary(folder.parent) is not None:
-                rows.append(row_of(f"plate-midedge {membrane} {folder.parent.name.split('_')[1]}", folder.parent))
+                n_rows, columns = size(folder.parent.name)
+                label = f"{n_rows} rows" + (f" x {columns} columns" if columns else "")
+                rows.append(row_of(f"plate-midedge {membrane} {label}", folder.parent))
     exact = clamped_elastica_midpoint_height(COMPRESSION_RATIO)
     summary = {"scene": {"width_ratio": WIDTH_RATIO, "compression_ratio": COMPRESSION_RATIO},
                "shear_ratio": SHEAR_RATIO, "shear_steps": SHEAR_STEPS, "at_dW_over_L": list(AT),
@@ -115,6 +127,7 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default="data/midedge_wide")
     parser.add_argument("--rows", type=int, nargs="+", default=list(ROWS))
     parser.add_argument("--membranes", nargs="+", default=list(MEMBRANES))
+    parser.add_argument("--no-anisotropic", action="store_true", help="without the ANISOTROPIC meshes")
     parser.add_argument("--table-only", action="store_true", help="no run: rewrite the table")
     args = parser.parse_args(argv)
     try:
@@ -131,6 +144,10 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     try:
         if not args.table_only:
+            for rows, columns in ([] if args.no_anisotropic else ANISOTROPIC):
+                summary = run_plate(rows, "psri", out / f"psri_R{rows}_C{columns}", columns)
+                print(f"psri {rows} rows x {columns} columns: dW1/L {summary.get('dW1_over_L')}", flush=True)
+                write_tables(out, ROOT_FEM)
             for membrane in args.membranes:
                 for rows in args.rows:
                     summary = run_plate(rows, membrane, out / f"{membrane}_R{rows}")

@@ -585,11 +585,12 @@ def _column_mesh(length: float, width: float, n_y: int, column_x: np.ndarray) ->
 
 
 def ghost_clamp_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANGLES, *,
-                     rows: int | None = None) -> PlateMesh:
+                     rows: int | None = None, columns: int | None = None) -> PlateMesh:
     """Structured mesh whose clamp lines are node columns, for the mid-edge plate.
 
     Columns at x = k L / n, k = -1 .. n + 1 (n even, so the centre (L/2, 0) is a node), rows
-    n_y across W (even), h_x = L / n nearest to sqrt(3)/2 W / n_y; about `triangles` triangles
+    n_y across W (even), h_x = L / n nearest to sqrt(3)/2 W / n_y (or n = `columns` given: an
+    anisotropic mesh, h_x independent of h_y); about `triangles` triangles
     in [0, L] (structured_size's rows), or `rows` = n_y given. The nodes of the columns x <= 0
     and x >= L are clamped (clamp_depth 0): the clamp columns x = 0 and x = L carry the clamped
     edges, and the columns at -h_x and L + h_x make one layer of rigid ghost triangles, whose
@@ -600,7 +601,12 @@ def ghost_clamp_mesh(length: float, width: float, triangles: int = DEFAULT_TRIAN
     rows = check_integer("rows", rows, 2, 100_000, "an even number of triangle rows across W")
     if rows % 2:
         raise InputError(f"rows = {rows} is odd; it must be even (the centre y = 0 is a row of nodes)")
-    n = max(2, 2 * int(round(length / (math.sqrt(3.0) * width / rows))))
+    if columns is None:
+        n = max(2, 2 * int(round(length / (math.sqrt(3.0) * width / rows))))
+    else:
+        n = check_integer("columns", columns, 2, 1_000_000, "an even number of element columns along L")
+        if n % 2:
+            raise InputError(f"columns = {n} is odd; it must be even (the centre x = L/2 is a column of nodes)")
     check_plate_size(length, width, 2 * n * rows)
     h_x = length / n
     nodes, tris = _zipper(width, rows, h_x * np.arange(-1, n + 2))

@@ -21,12 +21,13 @@ OUT/summary.json and OUT/wide_check.md hold the table.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import sys
 from pathlib import Path
 
-from ddg.output.io import atomic_write_text, finished_run_summary
+import numpy as np
+
+from ddg.output.io import StoredRun, atomic_write_text, finished_run_summary
 
 WIDTH_RATIO, COMPRESSION_RATIO = 1 / 2, 1 / 4
 ROWS = (16, 24, 36, 54)
@@ -58,23 +59,25 @@ def run_plate(rows: int, membrane: str, target: Path, columns: int | None = None
                         membrane=membrane, out=target, branches=False, centerline=False).summary
 
 
-def interpolate(folder: Path, column: str, dw: float) -> float | None:
-    """`column` of the shear stage of folder/path.csv at dW/L = dw (linear between recorded rows)."""
-    with open(folder / "path.csv") as fh:
-        rows = [(float(r["dW_over_L"]), float(r[column])) for r in csv.DictReader(fh) if r["stage"] == "shear"]
-    for (x0, y0), (x1, y1) in zip(rows, rows[1:]):
-        if x0 <= dw <= x1 and x1 > x0:
-            return y0 + (dw - x0) / (x1 - x0) * (y1 - y0)
-    return None
+def interpolate(run, column: str, dw: float) -> float | None:
+    """`column` of the shear stage of a StoredRun at dW/L = dw (linear between recorded rows; None
+    outside them)."""
+    rows = [r for r in run.rows if r["stage"] == "shear"]
+    x = np.array([r["dW_over_L"] for r in rows])
+    if not len(x) or not x.min() <= dw <= x.max():
+        return None
+    order = np.argsort(x)
+    return float(np.interp(dw, x[order], np.array([r[column] for r in rows], float)[order]))
 
 
 def row_of(label: str, folder: Path) -> dict:
-    summary = json.loads((folder / "summary.json").read_text())
+    run = StoredRun(folder)
+    summary = run.summary
     mesh = summary.get("mesh") or {}
     return {"run": label, "triangles": mesh.get("triangles"), "dW1_over_L": summary.get("dW1_over_L"),
             "H_mid_over_L_compressed": summary.get("H_mid_over_L_compressed"),
-            **{f"F_shear_norm_at_{dw:g}": interpolate(folder, "F_shear_norm", dw) for dw in AT},
-            **{f"H_mid_over_L_at_{dw:g}": interpolate(folder, "H_mid_over_L", dw) for dw in AT}}
+            **{f"F_shear_norm_at_{dw:g}": interpolate(run, "F_shear_norm", dw) for dw in AT},
+            **{f"H_mid_over_L_at_{dw:g}": interpolate(run, "H_mid_over_L", dw) for dw in AT}}
 
 
 def write_tables(out: Path, fem_root: Path) -> dict:

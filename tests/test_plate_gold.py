@@ -40,3 +40,20 @@ def test_a_scene_study_from_three_short_plate_runs(tmp_path):
     h = stored["H_mid_compressed"]
     assert h["error_bar"] is not None and abs(h["value"] - h["finest"]) <= 3 * h["error_bar"]
     assert (scene / "convergence.md").read_text().startswith("# Plate mesh study")
+
+
+@pytest.mark.parametrize("folder", ["plate_gold", "midedge_gold"])
+def test_stored_study_readme_lists_each_scenes_agreement_with_the_shell(folder):
+    """The README of each DDG study folder ends with the comparison against the shell's studies
+    (validation.plate_gold.agreement_lines) computed from its own index.json: regenerated whenever a
+    study changes (`--studies-only`), so the two cannot drift apart."""
+    from pathlib import Path
+
+    from validation.plate_gold import agreement_lines
+
+    root = Path(__file__).resolve().parents[1] / "data" / folder
+    index = json.loads((root / "index.json").read_text())
+    text = (root / "README.md").read_text()
+    lines = agreement_lines(index)
+    assert "\n".join(lines) in text
+    assert len(lines) == 4 + len(index)

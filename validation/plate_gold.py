@@ -184,7 +184,37 @@ def write_index(out: Path, model: str = "plate") -> None:
                       if est else ["-", "-", "-"])
         lines.append(f"| {name} | {', '.join(map(str, e['meshes']))} | {', '.join(map(str, e['triangles']))} | "
                      f"{' | '.join(cells)} | {e['wall_time_s']:.0f} |")
+    lines += ["", *agreement_lines(index)]
     atomic_write_text(out / "README.md", "\n".join(lines) + "\n")
+
+
+def agreement_lines(index: dict) -> list[str]:
+    """Markdown lines comparing each indexed study with the shell's (data/fem_gold) by the gold's
+    rule: |DDG - FEM| against the sum of the two error bars."""
+    from fem_reference.gold import all_scenes
+
+    from .estimates import load_study
+
+    lines = ["Against the shell's studies (data/fem_gold; the same error-bar rule): |diff|/combined is |DDG - FEM| "
+             "over the sum of the two error bars, at most 1 where they agree.", "",
+             "| scene | DDG dW1/L | FEM dW1/L | \\|diff\\|/combined | DDG dW2/L | FEM dW2/L | \\|diff\\|/combined |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    for name, compression, width, _ in all_scenes():
+        if name not in index:
+            continue
+        fem = load_study("fem", compression, width, name=name)
+        cells = []
+        for key in ("dW1", "dW2"):
+            mine = index[name].get(key)
+            theirs = getattr(fem, key) if fem is not None else None
+            cells.append(f"{_fmt(mine['value'])} +- {_fmt(mine['error_bar'])}" if mine else "-")
+            cells.append(f"{theirs.value:.4f} +- {theirs.error_bar:.4f}" if theirs else "-")
+            if mine and theirs and mine["error_bar"] is not None:
+                cells.append(f"{abs(mine['value'] - theirs.value) / (mine['error_bar'] + theirs.error_bar):.2f}")
+            else:
+                cells.append("-")
+        lines.append(f"| {name} | {' | '.join(cells)} |")
+    return lines
 
 
 def main(argv=None) -> int:

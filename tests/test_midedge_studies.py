@@ -95,6 +95,38 @@ def test_midedge_and_fem_thresholds_agree_within_their_combined_error_bars(reque
     assert abs(midedge.value - fem.value) <= midedge.error_bar + fem.error_bar, (midedge, fem)
 
 
+#: The error map's scenes (fem_reference.gold.MAP_SCENES), checked by the same rule where both
+#: studies have the threshold (at L/b = 4000 the shell stops at the fold of US: no dW2).
+MAP_SCENES = [("dL0.5_W0.125", 0.5, 1 / 8), ("dL0.25_W0.125", 0.25, 1 / 8), ("dL0.5_W0.25", 0.5, 1 / 4),
+              ("dL0.5_W0.05_Lb300", 0.5, 1 / 20), ("dL0.5_W0.1667_Lb300", 0.5, 1 / 6),
+              ("dL0.25_W0.25", 0.25, 1 / 4), ("dL0.5_W0.1", 0.5, 1 / 10), ("dL0.25_W0.1", 0.25, 1 / 10),
+              ("dL0.5_W0.05_Lb4000", 0.5, 1 / 20)]
+MAP_MISSES: dict[str, str] = {
+    "dL0.5_W0.1667_Lb300 dW2": "no mid-edge dW2 reported at W/L = 1/6, L/b = 300: the paths reach S at dW/L "
+                               "0.4560/0.4545/0.4537 (8/12/18 rows; the shell 0.4541 +- 0.0004), but the membrane "
+                               "strain reaches 0.0229/0.0224/0.0217 > 0.02 (the small-strain limit of "
+                               "ddg.protocol.validity) there, so each run withholds its dW2 as unresolved",
+}
+
+
+@pytest.mark.parametrize("quantity", ["dW1", "dW2"])
+@pytest.mark.parametrize("scene", MAP_SCENES, ids=[s[0] for s in MAP_SCENES])
+def test_midedge_and_fem_agree_at_the_error_maps_scenes(request, scene, quantity):
+    name, c, w = scene
+    if f"{name} {quantity}" in MAP_MISSES:
+        request.applymarker(pytest.mark.xfail(strict=True, reason=MAP_MISSES[f"{name} {quantity}"]))
+    from validation.estimates import load_study
+
+    fem, midedge = (load_study(m, c, w, name=name) for m in ("fem", "plate-midedge"))
+    assert midedge is not None and len(midedge.meshes) >= 3, f"no complete mid-edge study of {name}"
+    fem_value, midedge_value = getattr(fem, quantity), getattr(midedge, quantity)
+    if fem_value is None:
+        pytest.skip(f"the shell's study of {name} has no {quantity}")
+    assert midedge_value is not None, (name, quantity)
+    assert abs(midedge_value.value - fem_value.value) <= midedge_value.error_bar + fem_value.error_bar, \
+        (midedge_value, fem_value)
+
+
 @pytest.mark.parametrize("width", [1 / 6, 1 / 2], ids=["W1/6", "W1/2"])
 def test_midedge_dW1_sequence_is_monotone_and_converges_at_order_1_5(request, width):
     _xfail_if_missed(request, f"order W1/{round(1 / width)}")

@@ -34,15 +34,13 @@ import time
 from pathlib import Path
 
 from ddg.output.io import atomic_write_text, finished_run_summary, read_json_object
-from ddg.solve.thresholds import THRESHOLD_TOLERANCES
+
+from .estimates import DDG_TOLERANCES, load_study  # DDG_TOLERANCES: also read from here by benchmarks/
 
 #: Rows of triangles across W on the coarsest mesh (a multiple of 8: 1.5 and 2.25 times it stay even).
 BASE_ROWS = {1 / 20: 8, 1 / 12: 8, 1 / 10: 8, 1 / 8: 8, 1 / 6: 8, 1 / 4: 16, 1 / 3: 16, 1 / 2: 16}
 REFINEMENT = 1.5
 LEVELS = 3
-#: The DDG's threshold bisection brackets (ddg.solve.thresholds), for runs stored before their
-#: summary.json recorded them: each study's error bars include them.
-DDG_TOLERANCES = dict(zip(("dW1", "dW2"), THRESHOLD_TOLERANCES))
 
 
 def rows_sequence(width_ratio: float, levels: int = LEVELS) -> list[int]:
@@ -192,8 +190,6 @@ def agreement_lines(index: dict) -> list[str]:
     """Markdown lines comparing each indexed study with the shell's (data/fem_gold) by the gold's
     rule: |DDG - FEM| against the sum of the two error bars."""
     from fem_reference.gold import all_scenes
-
-    from .estimates import load_study
 
     lines = ["Against the shell's studies (data/fem_gold; the same error-bar rule): |diff|/combined is |DDG - FEM| "
              "over the sum of the two error bars, at most 1 where they agree.", "",

@@ -24,7 +24,7 @@ equilibria, so the whole bifurcation diagram can be traced, stable and unstable 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -128,11 +128,16 @@ class ArclengthTracer:
 
     def trace(self, start: State, direction: float = 1.0, tangent: tuple[np.ndarray, float] | None = None,
               shear_range: tuple[float, float] = (-np.inf, np.inf), stop=None,
-              max_points: int | None = None, initial_step: float | None = None) -> tuple[list[State], str]:
+              max_points: int | None = None, initial_step: float | None = None,
+              keep_hessians: bool = True) -> tuple[list[State], str]:
         """Equilibria along the branch through `start` (excluded), until dW leaves shear_range,
         stop(state) is true (that state is included if stop says True, dropped if it says
         "drop"), max_points, or the step falls below min_step. Returns the states and the reason
-        it ended."""
+        it ended.
+
+        keep_hessians=False keeps the Hessian on the last state only (each is a band of the whole
+        model: on a 15000-triangle plate about 90 MB, so a 200-point trace held 17 GB); the
+        others keep q, energy, gradient and frames, all that interpolating between them needs."""
         model = self.model
         opts = self.options
         free = model.free
@@ -168,6 +173,8 @@ class ArclengthTracer:
             tangent = self.tangent(new, previous=tangent)
             travelled = history[-1][0] + ds
             history = (history + [(travelled, new.q[free].copy(), new.shear)])[-3:]
+            if points and not keep_hessians and points[-1].evaluation is not None:
+                points[-1].evaluation = replace(points[-1].evaluation, hessian=None)
             points.append(new)
             state = new
             if verdict:

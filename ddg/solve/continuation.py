@@ -287,7 +287,7 @@ class PathFollower:
         def past_either_end(s):
             return (s.shear - shear) * direction >= 0 or (s.shear - state.shear) * direction < 0
 
-        points, _ = tracer.trace(state, direction, stop=past_either_end)
+        points, _ = tracer.trace(state, direction, stop=past_either_end, keep_hessians=False)
         self._spent(tracer.newton_iterations, "fold snaps")
         shears = np.array([state.shear] + [p.shear for p in points])
         if points and (points[-1].shear - shear) * direction >= 0:
@@ -333,7 +333,7 @@ class PathFollower:
             a, b = stop_s(s), stop_u(s)
             return True if (a is True or b is True) else ("drop" if (a or b) else False)
 
-        points, why = tracer.trace(turned, direction, stop=stop, max_points=60)
+        points, why = tracer.trace(turned, direction, stop=stop, max_points=60, keep_hessians=False)
         self._spent(tracer.newton_iterations, "fold snaps")
         if why != "stop condition" or not points:
             return None

@@ -31,9 +31,9 @@ __all__ = ["simulate", "run_ribbon", "simulate_dynamic", "make_model", "Simulati
 #: Default resolution per model: rod and ribbons M nodes (the ribbons' M is not a multiple of 4, see
 #: ddg.models.ribbon), plates target triangles.
 DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "plate-midedge": 2000, "ribbon": 101, "ribbon-sano-wada": 101,
-                      "ribbon-trapeze": 101, "ribbon-wunderlich": 101}
+                      "ribbon-trapeze": 101, "ribbon-cross-section": 101, "ribbon-wunderlich": 101}
 #: The models on the rod's centreline and frame (resolution = node count M).
-ROD_FAMILY = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-wunderlich")
+ROD_FAMILY = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section", "ribbon-wunderlich")
 
 
 #: Stations along the centerline exported per recorded step (centerline.csv).
@@ -262,7 +262,7 @@ def simulate(
     zeta (m): the regularisation length of model "ribbon" (Eq. A.5, default 1e4 L) and of
     "ribbon-wunderlich"'s ruling slope (default the Sano-Wada value sqrt((1 - nu) / 60) W^2 / b);
     summary keys zeta, zeta_over_L. The ribbons with width ("ribbon-sano-wada", "ribbon-trapeze",
-    "ribbon-wunderlich", ddg.models.wide_ribbons) run like the rod (resolution = nodes M).
+    "ribbon-cross-section", "ribbon-wunderlich", ddg.models.wide_ribbons) run like the rod (resolution = nodes M).
     membrane (model "plate-midedge" only): "psri" (default: alpha = b^2/h^2 of the constant-strain
     triangles, the rest node-smoothed, against membrane locking) or "full" (constant-strain
     triangles alone); ddg.models.midedge_plate.MEMBRANES, summary key membrane.

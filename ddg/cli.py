@@ -29,7 +29,7 @@ class _Parser(argparse.ArgumentParser):
 
 #: --model choices of simulate: the plates, the rod and the ribbons (ddg.api.DEFAULT_RESOLUTION).
 MODEL_CHOICES = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", "ribbon-trapeze",
-                 "ribbon-wunderlich")
+                 "ribbon-cross-section", "ribbon-wunderlich")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -40,7 +40,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="rod (DAR, default), plate (DEP on a triangle mesh), plate-midedge (mid-edge "
                           "Kirchhoff plate with the material's Poisson ratio), ribbon (Sadowsky, Eq. A.5), "
                           "ribbon-sano-wada (Eq. A.5 with zeta^2 = (1 - nu) W^4 / (60 b^2)), ribbon-trapeze "
-                          "(the rod plus the edges' stretching under twist) or ribbon-wunderlich (Eq. A.2)")
+                          "(the rod plus the edges' stretching under twist), ribbon-cross-section (the rod plus what the "
+                          "cross-section keeps of that stretching after bending to its least-energy shape, Audoly "
+                          "and Neukirch 2021) or ribbon-wunderlich (Eq. A.2)")
     sim.add_argument("--zeta", type=float, default=None,
                      help="ribbon: regularisation length zeta of Eq. (A.5) in metres (default 1e4 L); "
                           "ribbon-wunderlich: the same for its ruling slope (default the Sano-Wada value)")

@@ -44,7 +44,7 @@ from ddg.geometry.plate_mesh import mesh_from_arrays
 from ddg.models.plate import PlateModel
 from ddg.models.ribbon import RibbonModel
 from ddg.models.rod import RodModel
-from ddg.models.wide_ribbons import SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon
+from ddg.models.wide_ribbons import CrossSectionRibbon, SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon
 from rod_states import rod_dof_scale, twisted_rod_state
 
 LENGTH = 0.1
@@ -266,14 +266,15 @@ def plate_shape_measures(model: PlateModel, q: np.ndarray) -> dict:
 
 # --------------------------------------------------------------------------- rod and ribbon: models and states
 ROD_MODELS = ("rod", "ribbon zeta=0.5L", "ribbon zeta=10L", "ribbon-sano-wada", "ribbon-trapeze",
-              "ribbon-wunderlich")
+              "ribbon-cross-section", "ribbon-wunderlich")
 #: The energy parts each rod-family model reports beyond the rod's stretching, bending, twisting.
 EXTRA_PARTS = {"rod": set(), "ribbon zeta=0.5L": {"sadowsky"}, "ribbon zeta=10L": {"sadowsky"},
                "ribbon-sano-wada": {"sadowsky"}, "ribbon-trapeze": {"trapeze"},
+               "ribbon-cross-section": {"cross_section"},
                "ribbon-wunderlich": {"sadowsky", "wunderlich"}}
 #: Parts that may be negative: the trapeze coupling E b W^3 eps tau^2 / 24 where the centreline
 #: is compressed (eps < 0); with the stretching it forms a non-negative square (ddg.energies.trapeze).
-SIGNED_PARTS = {"trapeze"}
+SIGNED_PARTS = {"trapeze", "cross_section"}
 ROD_NODES = (9, 14)
 
 
@@ -289,6 +290,8 @@ def rod_family_model(kind: str, nodes: int) -> RodModel:
         return SanoWadaRibbon(strip(0.2 * LENGTH), nodes)
     if kind == "ribbon-trapeze":
         return TrapezeRibbon(strip(0.2 * LENGTH), nodes)
+    if kind == "ribbon-cross-section":
+        return CrossSectionRibbon(strip(0.2 * LENGTH), nodes)
     if kind == "ribbon-wunderlich":
         # W/L = 1/20 and zeta = 0.2 L keep the random states' |W eta'| at 0.1-1.3, inside the ruling
         # factor's pole at 2 (at W/L = 1/5 they cross it); g(v) - 1 then holds 1e-5 .. 5e-2 of the energy
@@ -368,7 +371,7 @@ def test_rod_family_states_are_generic(kind, nodes):
         # quartic term dominates at zeta = 10 L), stretching and bending at least 0.3 %; the
         # trapeze term at least 3.5e-5 and the Wunderlich pairs 2.5e-7 (M = 9, seed 1: nearly
         # uniform eta; those terms are checked alone in tests/test_wide_ribbons.py)
-        floors = {"trapeze": 1e-5, "wunderlich": 1e-7}
+        floors = {"trapeze": 1e-5, "cross_section": 1e-5, "wunderlich": 1e-7}
         assert all(abs(value) > floors.get(name, 5e-5) * ev.energy for name, value in ev.parts.items()), \
             (seed, ev.parts)
         theta = q[model.theta_dofs]

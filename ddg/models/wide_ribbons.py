@@ -12,6 +12,10 @@ or replaces the rod's bending and twisting (Eqs. 6b, 6c) with a ribbon energy of
   twist (ddg.energies.trapeze): E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640 per unit length.
   It keeps the rod's twist stiffness GJ, so it is exact for small W, and sees the width where
   W^2 tau / b is of order one.
+- `ribbon-cross-section` (CrossSectionRibbon): the rod plus the energy the cross-section keeps
+  after bending to its shape of least energy (ddg.energies.cross_section; Audoly and Neukirch
+  2021): the trapeze ribbon for a narrow strip or at an inflection point, Sadowsky's ribbon for a
+  wide one, through the closed-form share Psi(3 (1 - nu^2) kappa^2 W^4 / b^2).
 - `ribbon-wunderlich` (WunderlichRibbon): Wunderlich's finite-width developable ribbon, Eq. (A.2),
   regularised at inflection points as (A.5) is (ddg.energies.wunderlich); zeta defaults to the
   Sano-Wada value, and its effect is measured (validation/ribbon_regularisation.py).
@@ -22,6 +26,7 @@ import math
 
 import numpy as np
 
+from ..energies.cross_section import cross_section_coefficients, cross_section_density
 from ..energies.sadowsky import check_zeta
 from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_strain_blocks,
                                          stencil_stretch)
@@ -31,10 +36,23 @@ from ..geometry.strip import Strip
 from .ribbon import RibbonModel
 from .rod import RodModel
 
-__all__ = ["SanoWadaRibbon", "TrapezeRibbon", "WunderlichRibbon", "sano_wada_zeta", "WIDE_RIBBONS"]
+__all__ = ["SanoWadaRibbon", "TrapezeRibbon", "CrossSectionRibbon", "WunderlichRibbon", "sano_wada_zeta", "WIDE_RIBBONS"]
 
 #: Strain indices of rod_curvature's (kappa_n, kappa_g, tau) order used here.
 _KAPPA_N, _TAU = 0, 2
+
+
+def add_stretch_strain_terms(model, x, m1, m2, eps_derivatives, components, first, second, grad, band,
+                             hessian) -> None:
+    """Adds per-stencil terms of (the Voronoi mean stretch, the rod strains `components`) to grad
+    and (hessian) band: eps_derivatives = stencil_stretch's (gradients, Hessians); first (n, k)
+    and second (n, k, k) the density's partials in that order."""
+    eps_grad, eps_hess = eps_derivatives
+    grads, hessians = stencil_strain_blocks(x, m1, m2)
+    n = len(eps_grad)
+    local_grads = np.concatenate([eps_grad[:, None], grads[:, list(components)]], axis=1)
+    local_hess = np.concatenate([eps_hess[:, None], hessians[:, list(components)]], axis=1)
+    add_local_terms(4 * np.arange(n), local_grads, local_hess, first, second, model.n_dof, grad, band, hessian)
 
 
 def sano_wada_zeta(strip: Strip) -> float:
@@ -64,13 +82,30 @@ class TrapezeRibbon(RodModel):
         eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
         energy, first, second = trapeze_density(eps, tau, self.voronoi_lengths, *self.trapeze_coefficients)
         if gradient:
-            grads, hessians = stencil_strain_blocks(x, m1, m2)
-            n = len(eps)
-            local_grads = np.stack([eps_grad, grads[:, _TAU]], axis=1)
-            local_hess = np.stack([eps_hess, hessians[:, _TAU]], axis=1)
-            add_local_terms(4 * np.arange(n), local_grads, local_hess, first, second, self.n_dof, grad, band,
-                            hessian)
+            add_stretch_strain_terms(self, x, m1, m2, (eps_grad, eps_hess), (_TAU,), first, second, grad, band,
+                                     hessian)
         return {"trapeze": float(energy.sum())}
+
+
+class CrossSectionRibbon(RodModel):
+    """The DAR plus the relaxed cross-section's energy (ddg.energies.cross_section, Eq. R): the
+    edges' stretching under twist, less what the cross-section's transverse bending relieves."""
+
+    name = "ribbon-cross-section"
+
+    def __init__(self, strip: Strip, nodes: int = 101):
+        super().__init__(strip, nodes)
+        self.cross_section_coefficients = cross_section_coefficients(strip.young_modulus, strip.thickness,
+                                                                     strip.width, strip.poisson_ratio)
+
+    def coupled_terms(self, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
+        eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
+        energy, first, second = cross_section_density(eps, kappa_n, tau, self.voronoi_lengths,
+                                                      self.cross_section_coefficients)
+        if gradient:
+            add_stretch_strain_terms(self, x, m1, m2, (eps_grad, eps_hess), (_KAPPA_N, _TAU), first, second, grad,
+                                     band, hessian)
+        return {"cross_section": float(energy.sum())}
 
 
 class WunderlichRibbon(RibbonModel):
@@ -133,4 +168,4 @@ class WunderlichRibbon(RibbonModel):
 NEAR_POLE = 0.9
 
 #: The models of this module by their --model names.
-WIDE_RIBBONS = {cls.name: cls for cls in (SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon)}
+WIDE_RIBBONS = {cls.name: cls for cls in (SanoWadaRibbon, TrapezeRibbon, CrossSectionRibbon, WunderlichRibbon)}

@@ -18,7 +18,8 @@ from ..geometry.strip import InputError
 
 PACKAGE = Path(__file__).resolve().parent.parent  # ddg/
 
-MODELS = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-wunderlich")
+MODELS = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section",
+          "ribbon-wunderlich")
 
 #: Modules of this package that schedule runs and present results but take no part in computing
 #: one: editing them keeps every cached run (a new module is hashed until it is listed here).

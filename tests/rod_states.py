@@ -6,9 +6,13 @@ import numpy as np
 
 
 def rod_dof_scale(model) -> np.ndarray:
-    """Natural size of each DOF: the spacing h for positions, 1 rad for twist angles."""
+    """Natural size of each DOF: the spacing h for positions, 1 rad for twist angles, the model's
+    own unit for cross-section modes (1 / W for the transverse curvature)."""
     scale = np.full(model.n_dof, model.centerline.spacing)
     scale[model.theta_dofs] = 1.0
+    fields = model.field_dofs
+    if fields.size:
+        scale[fields] = model.length_scale()[fields]
     return scale
 
 
@@ -16,7 +20,8 @@ def twisted_rod_state(model, seed: int) -> np.ndarray:
     """A generic 3-D twisted state reached from rest through 3-5 random perturbations, each
     committed: positions by std 0.085 h per coordinate (~0.15 h per step), twist angles by std
     0.3 rad, so tangents leave the plane, frames are transported along non-planar paths and the
-    reference twist is non-zero; q is committed on return."""
+    reference twist is non-zero; cross-section modes (if any) by std 0.3 of their unit, except on
+    the clamped edges; q is committed on return."""
     rng = np.random.default_rng(seed)
     h = model.centerline.spacing
     q = model.reset()
@@ -24,6 +29,9 @@ def twisted_rod_state(model, seed: int) -> np.ndarray:
         dq = np.zeros(model.n_dof)
         dq[model.node_dofs] = 0.085 * h * rng.standard_normal((model.nodes, 3))
         dq[model.theta_dofs] = 0.3 * rng.standard_normal(model.nodes - 1)
+        fields = model.field_dofs[1:-1]
+        if fields.size:
+            dq[fields] = 0.3 * rng.standard_normal(fields.shape) * model.length_scale()[fields]
         q = q + dq
         model.commit(q)
     return q

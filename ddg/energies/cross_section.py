@@ -1,66 +1,233 @@
-"""The relaxed cross-section: a strip's energy per unit length when its cross-section takes the
-shape of least energy (issue 30; the one-dimensional ribbon model of Audoly and Neukirch 2021,
-"A one-dimensional model for elastic ribbons: a little stretching makes a big difference", JMPS).
+"""The cross-section as a field: a strip's energy per unit length when its cross-section bends
+(issue 30; the long-wavelength reduction of Audoly and Neukirch 2021, "A one-dimensional model for
+elastic ribbons: a little stretching makes a big difference", JMPS, with the cross-section kept as
+an unknown field along the strip instead of eliminated point by point).
 
-Derivation (written out here because the model is this derivation; the reference above is the
-published form of the same long-wavelength reduction). A strip of width W, thickness b, Young's
-modulus E, Poisson ratio nu, plate stiffness D = E b^3 / (12 (1 - nu^2)), has centreline strains
-that vary slowly along it: the stretch eps, the normal curvature kappa (bending about the width
-axis; the rod's kappa_n), the twist tau and the in-plane curvature kappa_g. Across the width,
-y in [-W/2, W/2], the cross-section deflects by w(y) normal to the strip. In the long-wavelength
-limit the transverse membrane stresses vanish (the long edges are free) and the Foppl-von Karman
-strip stores, per unit length,
+Derivation. A strip of width W, thickness b, Young's modulus E, Poisson ratio nu, plate stiffness
+D = E b^3 / (12 (1 - nu^2)), has centreline strains that vary slowly along it (arclength x): the
+stretch eps of the mid-width fibre, the normal curvature kappa (the rod's kappa_n), the twist tau
+and the in-plane curvature kappa_g. Across the width, y in [-W/2, W/2], the cross-section deflects
+by w(x, y) normal to the strip, with w = 0 on the centreline. In the long-wavelength limit the
+transverse membrane stress vanishes (the long edges are free), and the Foppl-von Karman strip
+stores, per unit length,
 
-    U = int { (E b / 2) e(y)^2 + (D / 2) [kappa^2 + w''^2 + 2 nu kappa w'' + 2 (1 - nu) tau^2] } dy,
-    e(y) = eps - kappa_g y + tau^2 y^2 / 2 - kappa w(y),
+    U = int { (E b / 2) e^2 + (D / 2) [kappa^2 + w_yy^2 + 2 nu kappa w_yy + 2 (1 - nu) (tau + w_xy)^2] } dy,
+    e(y) = eps - kappa_g y + tau^2 y^2 / 2 - kappa w(y),                                        (F)
 
-with e the axial strain of the fibre at y: the helix of a twisted strip lengthens its fibres by
-tau^2 y^2 / 2 (the trapeze effect, ddg.energies.trapeze) and a fibre lifted by w on a centreline
-of curvature kappa shortens by kappa w. The centreline is the cross-section's centroid and the
-material frame its mean orientation, int w dy = int y w dy = 0. The odd part of w then relieves
-nothing (kappa_g keeps the rod's E b W^3 / 12) and the even part solves the linear boundary value
-problem
+e being the axial strain of the fibre at y: the helix of a twisted strip lengthens its fibres by
+tau^2 y^2 / 2 (the trapeze effect, ddg.energies.trapeze) and a fibre lifted by w on a centreline of
+curvature kappa shortens by kappa w. The odd part of w relieves nothing (kappa_g keeps the rod's
+E b W^3 / 12). The even part is written in n modes,
 
-    D w'''' + E b kappa^2 w = E b kappa (e-independent load) + const,  w'' = -nu kappa,  w''' = 0 at y = +-W/2,
+    w_yy = sum_j c_j y^(2j - 2),  w = sum_j c_j B_j(y),  B_j = y^(2j) / ((2j - 1) 2j),  j = 1 .. n,
 
-in closed form (beam on an elastic foundation of modulus E b kappa^2). With k^4 = 3 (1 - nu^2)
-kappa^2 W^4 / b^2 the least energy is
+c_1 the transverse curvature on the centreline. With phi = (B_1, B_1, ..., B_n) and
+v = (tau^2, -kappa c_1, ..., -kappa c_n), e = eps - kappa_g y + phi . v, and (F) integrates to the
+rod's energy (E b W eps^2 / 2, EI kappa^2 / 2 with EI = E W b^3 / 12, GJ tau^2 / 2 with
+GJ = 2 D (1 - nu) W, E b W^3 kappa_g^2 / 24) plus this module's density
 
-    U = (E b W / 2) (eps + tau^2 W^2 / 24)^2 + (D W / 2) [(1 - nu^2) kappa^2 + 2 (1 - nu) tau^2]
-        + (E b W^5 / 8) Psi(k^4) (nu kappa^2 + tau^2)^2,                                      (R)
+    f = E b [eps m . v + v . S v / 2] + (D / 2) [c . P c + 2 nu kappa p . c + nu^2 W kappa^2]
+        + D (1 - nu) c' . Q c',                                                                 (X)
 
-    Psi(s) = Phi(k) / k^4,   Phi(k) = 1 - (2 / k) (cosh k - cos k) / (sinh k + sin k),  s = k^4,
+    m_a = int phi_a,  S_ab = int phi_a phi_b,  P_ij = int y^(2i + 2j - 4),  p_j = int y^(2j - 2),
+    Q_ij = int y^(2i + 2j - 2) / ((2i - 1)(2j - 1))   (integrals over the width),
 
-Phi being the share of the transverse bending (nu kappa + tau^2 / kappa) that the foundation
-forbids: Phi ~ k^4 / 180 for a narrow strip, Phi -> 1 - 2 / k for a wide one. The first two terms
-of (R) are the rod's stretching, bending EI = E W b^3 / 12 and twisting GJ = E W b^3 / (6 (1 + nu))
-plus the trapeze coupling E b W^3 eps tau^2 / 24 and E b W^5 tau^4 / 1152; the last is this
-module's. Its limits:
-- k -> 0 (narrow, or kappa -> 0 at an inflection point): Psi -> 1/180, and (R) is the trapeze
-  ribbon, E b W^5 tau^4 (1/1152 + 1/1440) = E b W^5 tau^4 / 640 (the cross-section cannot bend
-  away the edges' stretching without a curvature to bend against);
-- k -> infinity (wide): U -> (D W / 2) (kappa^2 + tau^2)^2 / kappa^2 with eps relaxed, Sadowsky's
-  developable ribbon, nu-independent; the bending stiffness of an untwisted strip goes from
-  E W b^3 / 12 to D W (the anticlastic, Ashwell, transition);
-- tau = 0, nu = 0: the term vanishes with its first derivatives, the rod and the exact elastica.
-  For nu > 0 an untwisted strip keeps the anticlastic term (E b W^5 / 8) Psi nu^2 kappa^4.
+c' = dc/dx: the last term is the twisting energy of a cross-section whose shape changes along
+the strip (w_xy = sum_j c_j' y^(2j - 1) / (2j - 1)); it makes c a field with an adaptation length,
+about 0.41 W (1 - nu)^(1/2) where kappa = 0. The x-derivatives of w in the axial curvature (w_xx)
+are dropped: next to the c'^2 term they are of relative size W^2 / (60 l^2) at adaptation length l.
 
-Discretely (integrated strains as the rod's, kappa -> kappa_i / dl_i, tau -> tau_i / dl_i,
-eps -> the Voronoi mean stretch of ddg.energies.stencil_coupling), per interior node
+Its limits, all exact:
+- c = 0 (the cross-section kept straight): f = E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640, the
+  trapeze ribbon (m_1 = W^3 / 24, S_11 = W^5 / 320);
+- tau = 0, nu = 0: f is a positive quadratic in c with its minimum c = 0, the rod and the exact
+  elastica (for nu > 0 an untwisted strip bends anticlastically, c_1 = -nu kappa while
+  kappa W^2 / b is small: the rod's EI; the stretching stiffens it to D W for kappa W^2 / b
+  large, Ashwell's transition);
+- W^2 kappa / b -> 0 or W^2 tau / b -> 0: the stretching terms vanish as W^5, c_1 -> -nu kappa,
+  and (X) with the rod's terms is the rod;
+- uniform strains, c eliminated point by point: the Audoly-Neukirch density
+  E b W^5 Psi(k^4) (nu kappa^2 + tau^2)^2 / 8, k^4 = 3 (1 - nu^2) kappa^2 W^4 / b^2, whose exact
+  cross-section (`foundation_share`, `psi`: a beam on an elastic foundation, solved in closed
+  form) the n modes approximate: the relieved energy is within 0.7 % of it for k <= 8 with two
+  modes and overestimates it by up to 31 % (k = 6) with one (tests/test_cross_section.py). As
+  k -> infinity both give Sadowsky's ribbon, (D W / 2)(kappa^2 + tau^2)^2 / kappa^2.
 
-    E_i = C3 eps_i tau_i^2 / dl_i + C5 tau_i^4 / dl_i^3 + A Psi(c kappa_i^2 / dl_i^2) (nu kappa_i^2 + tau_i^2)^2 / dl_i^3,
+Why a field and not the point-wise elimination: eliminating c point by point gives a density that
+is not convex in kappa where the twist is strong and the curvature small (W^2 tau / b above
+22680^(1/4) / sqrt(3) = 7.1 for nu = 0: an inflection point of a twisted strip), and the discrete
+paths then depend on the mesh (measured on W/L = 1/20, dL/L = 1/2, L/b = 1181: the U's pitchfork at
+dW/L = 0.408 on 51 nodes, none on 101; the shell's is 0.351). With c a field, f is a convex
+quadratic in kappa at fixed c, and the c'^2 term lets the cross-section change only over its
+adaptation length, as it does in the plate.
 
-C3 = E b W^3 / 24, C5 = E b W^5 / 1152, A = E b W^5 / 8, c = 3 (1 - nu^2) W^4 / b^2. Psi is
-evaluated by its Taylor series in s below SERIES_BELOW (the closed form cancels there) and by the
-closed form, scaled by e^-k so that it holds for any k, above; both with exact first and second
-derivatives, so Newton and the stability test see the exact Hessian of (R).
+Discretely: c^e lives on the edges (after each twist angle, ddg.models.wide_ribbons), c = 0 on the
+two clamped edges, whose midpoints are the clamp points (the clamp holds the cross-section
+straight). Per interior node i, with l = dl_i (its Voronoi length, the distance between the
+midpoints of its edges), kappa -> kappa_i / l, tau -> tau_i / l (the rod's integrated strains),
+eps -> the Voronoi mean stretch (ddg.energies.stencil_coupling), c -> (c^{i-1} + c^i) / 2 and
+c' -> (c^i - c^{i-1}) / l:
+
+    E_i = l f(eps_i, kappa_i / l, tau_i / l, (c^{i-1} + c^i) / 2) + D (1 - nu) dc . Q dc / l,
+    dc = c^i - c^{i-1}.
+
+`field_density` returns E_i and its exact first and second partials in the stencil's strains
+(eps, kappa_i, tau_i, c^{i-1}, c^i): f is a polynomial.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-__all__ = ["cross_section_coefficients", "cross_section_density", "relaxed_share", "well_bottom", "psi",
-           "foundation_share", "SERIES_BELOW"]
+__all__ = ["CrossSectionModes", "field_density", "local_optimum", "psi", "foundation_share", "SERIES_BELOW"]
+
+
+def _width_integral(power: np.ndarray | int, width: float):
+    """int_{-W/2}^{W/2} y^power dy for even powers."""
+    power = np.asarray(power)
+    return 2.0 * (0.5 * width) ** (power + 1) / (power + 1)
+
+
+@dataclass(frozen=True)
+class CrossSectionModes:
+    """The width integrals of (X) for n modes of a strip's cross-section, and its stiffnesses."""
+
+    width: float
+    thickness: float
+    young_modulus: float
+    poisson_ratio: float
+    modes: int
+
+    def __post_init__(self):
+        if not (isinstance(self.modes, (int, np.integer)) and 1 <= self.modes <= 4):
+            raise ValueError(f"modes = {self.modes!r} outside the allowed range 1 .. 4")
+        w, n = self.width, self.modes
+        j = np.arange(1, n + 1)
+        # phi = (B_1, B_1 .. B_n): powers and denominators of y^(2j) / ((2j - 1) 2j)
+        powers = np.r_[2, 2 * j]
+        denominators = np.r_[2.0, (2 * j - 1) * 2.0 * j]
+        m = _width_integral(powers, w) / denominators
+        s = _width_integral(powers[:, None] + powers[None, :], w) / (denominators[:, None] * denominators[None, :])
+        p = _width_integral(2 * j - 2, w)
+        big_p = _width_integral((2 * j - 2)[:, None] + (2 * j - 2)[None, :], w)
+        odd = 2 * j - 1
+        q = _width_integral(odd[:, None] + odd[None, :], w) / (odd[:, None] * odd[None, :])
+        object.__setattr__(self, "m", m)
+        object.__setattr__(self, "S", s)
+        object.__setattr__(self, "p", p)
+        object.__setattr__(self, "P", big_p)
+        object.__setattr__(self, "Q", q)
+
+    @property
+    def membrane(self) -> float:
+        """E b: the membrane stiffness per unit width."""
+        return self.young_modulus * self.thickness
+
+    @property
+    def plate(self) -> float:
+        """D = E b^3 / (12 (1 - nu^2))."""
+        nu = self.poisson_ratio
+        return self.young_modulus * self.thickness**3 / (12.0 * (1.0 - nu * nu))
+
+
+def _point_density(eps, k, t, c, modes: CrossSectionModes):
+    """f of (X) without its c' term at points (eps, k, t, c (N, n)): values (N,), partials (N, 3 + n)
+    and second partials (N, 3 + n, 3 + n) in z = (eps, kappa, tau, c_1 .. c_n)."""
+    n = modes.modes
+    eb, d, nu = modes.membrane, modes.plate, modes.poisson_ratio
+    size = 3 + n
+    count = len(eps)
+    v = np.empty((count, n + 1))
+    v[:, 0] = t * t
+    v[:, 1:] = -k[:, None] * c
+    # G(eps, v) = E b [eps m . v + v . S v / 2]: its gradient and (constant) Hessian in (eps, v)
+    sv = v @ modes.S
+    g_w = np.empty((count, n + 2))
+    g_w[:, 0] = eb * (v @ modes.m)
+    g_w[:, 1:] = eb * (eps[:, None] * modes.m[None, :] + sv)
+    h_g = np.zeros((n + 2, n + 2))
+    h_g[0, 1:] = h_g[1:, 0] = eb * modes.m
+    h_g[1:, 1:] = eb * modes.S
+    # w = (eps, v) as functions of z: Jacobian and the nonzero second derivatives
+    jac = np.zeros((count, n + 2, size))
+    jac[:, 0, 0] = 1.0
+    jac[:, 1, 2] = 2.0 * t
+    jac[:, 2:, 1] = -c
+    idx = np.arange(n)
+    jac[:, 2 + idx, 3 + idx] = -k[:, None]
+    value = eb * (eps * (v @ modes.m) + 0.5 * np.einsum("na,na->n", v, sv))
+    first = np.einsum("naz,na->nz", jac, g_w)
+    second = np.einsum("naz,ab,nby->nzy", jac, h_g, jac)
+    second[:, 2, 2] += 2.0 * g_w[:, 1]            # d2 (tau^2) / dtau2
+    second[:, 1, 3 + idx] += -g_w[:, 2:]           # d2 (-kappa c_j) / dkappa dc_j
+    second[:, 3 + idx, 1] += -g_w[:, 2:]
+    # the plate's bending beyond the rod's: (D / 2) [c . P c + 2 nu kappa p . c + nu^2 W kappa^2]
+    pc = c @ modes.P
+    value += 0.5 * d * (np.einsum("nj,nj->n", c, pc) + 2.0 * nu * k * (c @ modes.p) + nu * nu * modes.width * k * k)
+    first[:, 1] += d * (nu * (c @ modes.p) + nu * nu * modes.width * k)
+    first[:, 3:] += d * (pc + nu * k[:, None] * modes.p[None, :])
+    second[:, 1, 1] += d * nu * nu * modes.width
+    second[:, 1, 3:] += d * nu * modes.p
+    second[:, 3:, 1] += d * nu * modes.p
+    second[:, 3:, 3:] += d * modes.P
+    return value, first, second
+
+
+def field_density(eps, kappa, tau, c_before, c_after, voronoi_lengths, modes: CrossSectionModes):
+    """E_i per stencil (N,) and its partials (N, 3 + 2n) and second partials (N, 3 + 2n, 3 + 2n) in
+    the stencil's strains u = (eps_i, kappa_i, tau_i, c^{i-1}_1..n, c^i_1..n): kappa, tau the
+    rod's integrated strains (Eqs. 3-5), eps the Voronoi mean stretch, c_before/c_after (N, n) the
+    cross-section modes of the stencil's two edges."""
+    n = modes.modes
+    ell = np.asarray(voronoi_lengths, dtype=float)
+    c_mean = 0.5 * (c_before + c_after)
+    f, f_z, f_zz = _point_density(eps, kappa / ell, tau / ell, c_mean, modes)
+    count = len(ell)
+    size = 3 + 2 * n
+    # u -> z: eps, kappa / l, tau / l, (c_before + c_after) / 2
+    scale = np.zeros((count, 3 + n, size))
+    scale[:, 0, 0] = 1.0
+    scale[:, 1, 1] = scale[:, 2, 2] = 1.0 / ell
+    idx = np.arange(n)
+    scale[:, 3 + idx, 3 + idx] = 0.5
+    scale[:, 3 + idx, 3 + n + idx] = 0.5
+    energy = ell * f
+    first = ell[:, None] * np.einsum("nzu,nz->nu", scale, f_z)
+    second = ell[:, None, None] * np.einsum("nzu,nzy,nyv->nuv", scale, f_zz, scale)
+    # the cross-section's change along the strip: D (1 - nu) dc . Q dc / l
+    g = modes.plate * (1.0 - modes.poisson_ratio)
+    dc = c_after - c_before
+    qdc = dc @ modes.Q
+    energy += g * np.einsum("nj,nj->n", dc, qdc) / ell
+    first[:, 3:3 + n] -= 2.0 * g * qdc / ell[:, None]
+    first[:, 3 + n:] += 2.0 * g * qdc / ell[:, None]
+    block = 2.0 * g * modes.Q[None, :, :] / ell[:, None, None]
+    second[:, 3:3 + n, 3:3 + n] += block
+    second[:, 3 + n:, 3 + n:] += block
+    second[:, 3:3 + n, 3 + n:] -= block
+    second[:, 3 + n:, 3:3 + n] -= block
+    return energy, first, second
+
+
+def local_optimum(kappa, tau, modes: CrossSectionModes):
+    """The least energy of the cross-section at uniform strains (kappa, tau per unit length, c' = 0),
+    with the mid-fibre stretch eps relaxed too: min over (eps, c) of E b W eps^2 / 2 + f (Eq. X),
+    a quadratic, so one linear solve each. Returns (eps, c (N, n), energy (N,)): the energy beyond
+    the rod's bending and twisting that the Audoly-Neukirch density gives exactly as
+    E b W^5 Psi(k^4) (nu kappa^2 + tau^2)^2 / 8 (`psi`)."""
+    kappa, tau = (np.atleast_1d(np.asarray(a, dtype=float)) for a in (kappa, tau))
+    n = modes.modes
+    zero = np.zeros(len(kappa))
+    value, first, second = _point_density(zero, kappa, tau, np.zeros((len(kappa), n)), modes)
+    unknowns = np.r_[0, 3 + np.arange(n)]  # eps and the modes
+    hessian = second[:, unknowns][:, :, unknowns]
+    hessian[:, 0, 0] += modes.membrane * modes.width
+    solution = -np.linalg.solve(hessian, first[:, unknowns][..., None])[..., 0]
+    eps, c = solution[:, 0], solution[:, 1:]
+    energy = _point_density(eps, kappa, tau, c, modes)[0] + 0.5 * modes.membrane * modes.width * eps**2
+    return eps, c, energy
+
 
 #: Taylor coefficients of Psi(s) = sum_n a_n s^n (exact rationals from the series of Phi(k) / k^4,
 #: tests/test_cross_section.py re-derives the first ones); the radius of convergence is about
@@ -116,116 +283,3 @@ def psi(s):
     return value, first, second
 
 
-def cross_section_coefficients(young_modulus: float, thickness: float, width: float,
-                               poisson_ratio: float) -> tuple[float, float, float, float, float]:
-    """(C3, C5, G0, c, nu): C3 = E b W^3 / 24, C5 = E b W^5 / 1152, c = 3 (1 - nu^2) W^4 / b^2 and
-    G0 = E W b^3 / (24 c), the unit of the scaled density (G0 K^2 is the rod's bending EI kappa^2 / 2)."""
-    e, b, w, nu = young_modulus, thickness, width, poisson_ratio
-    c = 3.0 * (1.0 - nu * nu) * w**4 / b**2
-    return (e * b * w**3 / 24.0, e * b * w**5 / 1152.0, e * w * b**3 / (24.0 * c), c, nu)
-
-
-def _share_terms(s, t, nu):
-    """phi = Psi(s) q^2 / m (q = nu s + T^2, m = 1 - nu^2) and its partials phi_s, phi_ss, phi_T,
-    phi_TT, phi_sT at s = K^2 (arrays)."""
-    m = 1.0 - nu * nu
-    p, p1, p2 = psi(s)
-    q = nu * s + t * t
-    phi = p * q * q / m
-    phi_s = (p1 * q * q + 2.0 * nu * p * q) / m
-    phi_ss = (p2 * q * q + 4.0 * nu * p1 * q + 2.0 * nu * nu * p) / m
-    phi_t = 4.0 * p * q * t / m
-    phi_tt = 4.0 * p * (q + 2.0 * t * t) / m
-    phi_st = 4.0 * t * (p1 * q + nu * p) / m
-    return phi, phi_s, phi_ss, phi_t, phi_tt, phi_st
-
-
-def well_bottom(t, nu, iterations: int = 60):
-    """s_m = K_m^2 where the scaled bending density K^2 + phi(K^2, T) is least, for each T whose
-    density has a double well (1 + phi_s(0, T) < 0); nan elsewhere. Safeguarded Newton on
-    h(s) = 1 + phi_s(s, T), which is negative at 0 and tends to 1 / (1 - nu^2) (one root)."""
-    t = np.asarray(t, dtype=float)
-    out = np.full(t.shape, np.nan)
-    h0 = 1.0 + _share_terms(np.zeros_like(t), t, nu)[1]
-    well = h0 < 0.0
-    if not np.any(well):
-        return out
-    tw = t[well]
-    lo = np.zeros_like(tw)
-    hi = np.maximum(tw * tw, 1.0)
-    for _ in range(200):  # grow the bracket until h(hi) > 0
-        bad = 1.0 + _share_terms(hi, tw, nu)[1] <= 0.0
-        if not np.any(bad):
-            break
-        hi = np.where(bad, 2.0 * hi, hi)
-    s = 0.5 * (lo + hi)
-    for _ in range(iterations):
-        _, phi_s, phi_ss, _, _, _ = _share_terms(s, tw, nu)
-        h = 1.0 + phi_s
-        lo = np.where(h < 0.0, s, lo)
-        hi = np.where(h < 0.0, hi, s)
-        step = s - h / phi_ss
-        inside = np.isfinite(step) & (step > lo) & (step < hi)
-        new = np.where(inside, step, 0.5 * (lo + hi))
-        if np.all(np.abs(new - s) <= 1e-15 * np.maximum(new, 1.0)):
-            s = new
-            break
-        s = new
-    out[well] = s
-    return out
-
-
-def relaxed_share(k, t, nu, relaxed: bool = True):
-    """The scaled density beyond the rod's bending, f(K, T) = phi(K^2, T) (K = sqrt(c) kappa,
-    T = sqrt(c) tau), and its partials f_K, f_T, f_KK, f_KT, f_TT (arrays).
-
-    relaxed: where K^2 + phi has a double well in K (strong twist near an inflection point, T
-    above about 12.3 for nu = 0) the bending density is replaced by its convex envelope in K,
-    flat at the bottom of the well for |K| < K_m (f = K_m^2 + phi(K_m^2, T) - K^2 there); see the
-    module docstring."""
-    s = k * k
-    phi, phi_s, phi_ss, phi_t, phi_tt, phi_st = _share_terms(s, t, nu)
-    f = phi
-    f_k = 2.0 * k * phi_s
-    f_kk = 2.0 * phi_s + 4.0 * s * phi_ss
-    f_t = phi_t
-    f_kt = 2.0 * k * phi_st
-    f_tt = phi_tt
-    if relaxed:
-        sm = well_bottom(t, nu)
-        flat = np.isfinite(sm) & (s < np.nan_to_num(sm, nan=-1.0))
-        if np.any(flat):
-            smf, tf = sm[flat], t[flat]
-            mphi, _, mphi_ss, mphi_t, mphi_tt, mphi_st = _share_terms(smf, tf, nu)
-            f = np.where(flat, 0.0, f)
-            f[flat] = smf + mphi - s[flat]
-            f_k[flat] = -2.0 * k[flat]
-            f_kk[flat] = -2.0
-            f_kt[flat] = 0.0
-            f_t[flat] = mphi_t
-            f_tt[flat] = mphi_tt - mphi_st**2 / mphi_ss
-    return f, f_k, f_t, f_kk, f_kt, f_tt
-
-
-def cross_section_density(eps, kappa, tau, voronoi_lengths, coefficients, relaxed: bool = True):
-    """E_i per stencil (n,), partials in (eps, kappa_n, tau) (n, 3) and second partials (n, 3, 3).
-
-    eps: the stencils' centreline stretch; kappa, tau: their integrated normal curvature and twist
-    (Eqs. 3-5); coefficients from cross_section_coefficients; relaxed: see relaxed_share."""
-    c3, c5, g0, c, nu = coefficients
-    dl = voronoi_lengths
-    root = np.sqrt(c)
-    k, t = root * kappa / dl, root * tau / dl
-    f, f_k, f_t, f_kk, f_kt, f_tt = relaxed_share(k, t, nu, relaxed)
-    t2 = tau * tau
-    energy = c3 * eps * t2 / dl + c5 * t2 * t2 / dl**3 + g0 * dl * f
-    first = np.empty((len(energy), 3))
-    first[:, 0] = c3 * t2 / dl
-    first[:, 1] = g0 * root * f_k
-    first[:, 2] = 2.0 * c3 * eps * tau / dl + 4.0 * c5 * tau * t2 / dl**3 + g0 * root * f_t
-    second = np.zeros((len(energy), 3, 3))
-    second[:, 0, 2] = second[:, 2, 0] = 2.0 * c3 * tau / dl
-    second[:, 1, 1] = g0 * c * f_kk / dl
-    second[:, 1, 2] = second[:, 2, 1] = g0 * c * f_kt / dl
-    second[:, 2, 2] = 2.0 * c3 * eps / dl + 12.0 * c5 * t2 / dl**3 + g0 * c * f_tt / dl
-    return energy, first, second

@@ -270,12 +270,14 @@ def strain_derivatives(x: np.ndarray, m1: np.ndarray, m2: np.ndarray):
 
 
 @njit(cache=True)
-def add_stencil_terms(x, m1, m2, first, second, first_offset, n_dof, grad, band, want_hessian):
+def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, want_hessian):
     """Chain rule for an energy sum_i e(kappa_n, kappa_g, tau) of the stencils: adds its gradient
     to grad and (want_hessian) its Hessian to the flattened lower band of an n_dof matrix.
 
-    first (n, 3): de/ds_c per stencil; second (n, 3, 3): d2e/ds_c ds_d; stencil i starts at DOF
-    first_offset + 4 i (the rod's layout, Eq. 1)."""
+    first (n, 3): de/ds_c per stencil; second (n, 3, 3): d2e/ds_c ds_d; node j's position starts at
+    DOF node_stride * j, edge j's twist angle follows it (the rod's layout, Eq. 1, has
+    node_stride = 4; a model with more DOFs per edge, ddg.models.wide_ribbons.CrossSectionRibbon,
+    puts them after the angle), so stencil i starts at DOF node_stride * i."""
     strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w = _scratch()
     g11 = np.empty((3, STENCIL_SIZE))
     h11 = np.empty((STENCIL_SIZE, STENCIL_SIZE))
@@ -285,14 +287,17 @@ def add_stencil_terms(x, m1, m2, first, second, first_offset, n_dof, grad, band,
     eth = np.empty((3, 2))
     fth = np.empty((3, 2))
     thth = np.empty(2)
+    place = np.empty(STENCIL_SIZE, dtype=np.int64)  # the stencil's 11 DOFs within its block
+    for a in range(STENCIL_SIZE):
+        place[a] = a + (a // 4) * (node_stride - 4)
     for i in range(x.shape[0] - 2):
         _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1],
                  strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w)
-        base = first_offset + 4 * i
+        base = node_stride * i
         for c in range(3):
             _stencil_gradient(ge, gf, gth, c, g11[c])
         for a in range(STENCIL_SIZE):
-            grad[base + a] += first[i, 0] * g11[0, a] + first[i, 1] * g11[1, a] + first[i, 2] * g11[2, a]
+            grad[base + place[a]] += first[i, 0] * g11[0, a] + first[i, 1] * g11[1, a] + first[i, 2] * g11[2, a]
         if not want_hessian:
             continue
         w0, w1, w2 = first[i, 0], first[i, 1], first[i, 2]
@@ -307,8 +312,9 @@ def add_stencil_terms(x, m1, m2, first, second, first_offset, n_dof, grad, band,
         for j in range(2):
             thth[j] = w0 * hthth[0, j] + w1 * hthth[1, j] + w2 * hthth[2, j]
         _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, h11)
-        # the stencil's DOFs are contiguous (base .. base + 10): entry (a, b), a >= b, of its
-        # Hessian lands at band[(a - b) * n + base + b]; only the lower triangle is formed
+        # the stencil's DOFs are increasing in a (contiguous, base .. base + 10, for the rod):
+        # entry (a, b), a >= b, of its Hessian lands at band[(place[a] - place[b]) * n + base +
+        # place[b]]; only the lower triangle is formed
         for c in range(3):
             for d in range(3):
                 coefficient = second[i, c, d]
@@ -319,5 +325,5 @@ def add_stencil_terms(x, m1, m2, first, second, first_offset, n_dof, grad, band,
                             h11[a, b] += ga * g11[d, b]
         for a in range(STENCIL_SIZE):
             for b in range(a + 1):
-                band[(a - b) * n_dof + base + b] += h11[a, b]
+                band[(place[a] - place[b]) * n_dof + base + place[b]] += h11[a, b]
 

@@ -1,7 +1,8 @@
 """Discrete Anisotropic Rod (DAR), paper section 3.1.
 
 DOF vector q = [x_0, theta^0, x_1, theta^1, ..., theta^{M-2}, x_{M-1}] (Eq. 1), 4M - 1
-entries. Energy: stretching (Eq. 6a), bending with both material curvatures (Eqs. 3-4, 6b)
+entries (a model with `edge_fields` more DOFs per edge puts them after each theta^j:
+node_stride = 4 + edge_fields, ddg.models.wide_ribbons.CrossSectionRibbon). Energy: stretching (Eq. 6a), bending with both material curvatures (Eqs. 3-4, 6b)
 and twisting with reference twist (Eqs. 5, 6c). Clamps (section 4): x_0, theta^0, x_1 and
 x_{M-2}, theta^{M-2}, x_{M-1} are prescribed, 14 DOFs; the clamped edges straddle the clamp
 points (see ddg.geometry.centerline) so the free length is exactly L. The material frame
@@ -23,30 +24,30 @@ from .base import BandedModel, Evaluation
 
 __all__ = ["RodModel", "Evaluation"]
 
-CLAMPED_DOFS_PER_END = 7
-
-
 class RodModel(BandedModel):
     """The DAR of a Strip on a Centerline of M nodes, with its reference-frame state."""
 
     name = "rod"
     bandwidth = 10
+    edge_fields = 0  # DOFs per edge beyond the twist angle (the rod has none)
 
     def __init__(self, strip: Strip, nodes: int = 100):
         self.strip = strip
         self.centerline = Centerline(strip.length, nodes)
         m = nodes
         self.nodes = m
-        self.n_dof = 4 * m - 1
-        self.node_dofs = 4 * np.arange(m)[:, None] + np.arange(3)[None, :]
-        self.theta_dofs = 4 * np.arange(m - 1) + 3
+        stride = self.node_stride = 4 + self.edge_fields
+        self.n_dof = stride * (m - 1) + 3
+        self.node_dofs = stride * np.arange(m)[:, None] + np.arange(3)[None, :]
+        self.theta_dofs = stride * np.arange(m - 1) + 3
+        self.field_dofs = stride * np.arange(m - 1)[:, None] + 4 + np.arange(self.edge_fields)[None, :]
+        clamped = self.clamped_per_end = stride + 3  # x_0, theta^0 (and its fields), x_1
         h = self.centerline.spacing
         self.rest_edge_lengths = np.full(m - 1, h)
         self.voronoi_lengths = 0.5 * (self.rest_edge_lengths[:-1] + self.rest_edge_lengths[1:])
         self.stretch_stiffness = strip.stretching_stiffness / self.rest_edge_lengths  # Eq. (6a)
-        self.constrained = np.r_[np.arange(CLAMPED_DOFS_PER_END), np.arange(self.n_dof - CLAMPED_DOFS_PER_END,
-                                                                            self.n_dof)]
-        self.free = slice(CLAMPED_DOFS_PER_END, self.n_dof - CLAMPED_DOFS_PER_END)
+        self.constrained = np.r_[np.arange(clamped), np.arange(self.n_dof - clamped, self.n_dof)]
+        self.free = slice(clamped, self.n_dof - clamped)
         self._edge_nodes = np.stack([np.arange(m - 1), np.arange(1, m)], axis=1)
         self.reset()
 
@@ -87,12 +88,14 @@ class RodModel(BandedModel):
 
     # ------------------------------------------------------------------ clamps
     def clamp_values(self, compression: float, shear: float) -> np.ndarray:
-        """Prescribed values of the 14 clamped DOFs for clamp displacement (-dL, dW, 0)."""
+        """Prescribed values of the clamped DOFs (14 for the rod) for clamp displacement (-dL, dW, 0):
+        the clamped edges' positions move, their angles (and edge fields) keep their rest values."""
         rest = self.rest_state()
         values = rest[self.constrained].copy()
-        right = slice(CLAMPED_DOFS_PER_END, 2 * CLAMPED_DOFS_PER_END)
-        shift = np.array([-compression, shear, 0.0, 0.0, -compression, shear, 0.0])
-        values[right] += shift
+        n = self.clamped_per_end
+        shift = np.zeros(n)
+        shift[0:3] = shift[n - 3:n] = (-compression, shear, 0.0)
+        values[n:] += shift
         return values
 
     def midpoint(self, q: np.ndarray) -> np.ndarray:
@@ -150,15 +153,15 @@ class RodModel(BandedModel):
         hessian = hessian and gradient
         n = self.n_dof
         grad, band = self._accumulators(gradient, hessian)
-        stretching = add_edge_terms(x, self._edge_nodes, self.rest_edge_lengths, self.stretch_stiffness, 4, n,
-                                    grad, band, gradient, hessian)
+        stretching = add_edge_terms(x, self._edge_nodes, self.rest_edge_lengths, self.stretch_stiffness,
+                                    self.node_stride, n, grad, band, gradient, hessian)
         if gradient:
-            add_stencil_terms(x, m1, m2, first, second, 0, n, grad, band, hessian)
-        parts.update(self.coupled_terms(x, m1, m2, kappa_n, tau, grad, band, gradient, hessian))
+            add_stencil_terms(x, m1, m2, first, second, self.node_stride, n, grad, band, hessian)
+        parts.update(self.coupled_terms(q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian))
         return self._evaluation({"stretching": float(stretching), **parts}, grad, band, gradient, hessian,
                                 frames=(t, d1, m_ref))
 
-    def coupled_terms(self, x, m1, m2, kappa_n, tau, grad, band, gradient: bool, hessian: bool) -> dict:
+    def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient: bool, hessian: bool) -> dict:
         """Energies beyond the per-stencil densities (the ribbons with width: the trapeze term's
         stretch-twist coupling, Wunderlich's pairs of stencils): adds their gradient and Hessian
         into grad and band (ddg.energies.stencil_coupling) and returns their totals by part. The

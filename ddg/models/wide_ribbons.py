@@ -12,10 +12,13 @@ or replaces the rod's bending and twisting (Eqs. 6b, 6c) with a ribbon energy of
   twist (ddg.energies.trapeze): E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640 per unit length.
   It keeps the rod's twist stiffness GJ, so it is exact for small W, and sees the width where
   W^2 tau / b is of order one.
-- `ribbon-cross-section` (CrossSectionRibbon): the rod plus the energy the cross-section keeps
-  after bending to its shape of least energy (ddg.energies.cross_section; Audoly and Neukirch
-  2021): the trapeze ribbon for a narrow strip or at an inflection point, Sadowsky's ribbon for a
-  wide one, through the closed-form share Psi(3 (1 - nu^2) kappa^2 W^4 / b^2).
+- `ribbon-cross-section` (CrossSectionRibbon): the rod plus its cross-section as a field: two
+  modes of the transverse deflection per edge (DOFs after each twist angle), which bend to relieve
+  the edges' stretching under twist (ddg.energies.cross_section, after Audoly and Neukirch 2021):
+  the rod for a narrow strip, the trapeze ribbon where the cross-section cannot bend, Sadowsky's
+  ribbon for a wide one. It has more DOFs than the rod (6M - 3 against 4M - 1): the
+  cross-section's shape changes along the strip over about 0.4 W, which a density of the rod's
+  strains alone cannot hold (ddg.energies.cross_section, "Why a field").
 - `ribbon-wunderlich` (WunderlichRibbon): Wunderlich's finite-width developable ribbon, Eq. (A.2),
   regularised at inflection points as (A.5) is (ddg.energies.wunderlich); zeta defaults to the
   Sano-Wada value, and its effect is measured (validation/ribbon_regularisation.py).
@@ -26,7 +29,7 @@ import math
 
 import numpy as np
 
-from ..energies.cross_section import cross_section_coefficients, cross_section_density
+from ..energies.cross_section import CrossSectionModes, field_density
 from ..energies.sadowsky import check_zeta
 from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_strain_blocks,
                                          stencil_stretch)
@@ -78,7 +81,7 @@ class TrapezeRibbon(RodModel):
         super().__init__(strip, nodes)
         self.trapeze_coefficients = trapeze_coefficients(strip.young_modulus, strip.thickness, strip.width)
 
-    def coupled_terms(self, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
+    def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
         eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
         energy, first, second = trapeze_density(eps, tau, self.voronoi_lengths, *self.trapeze_coefficients)
         if gradient:
@@ -88,24 +91,83 @@ class TrapezeRibbon(RodModel):
 
 
 class CrossSectionRibbon(RodModel):
-    """The DAR plus the relaxed cross-section's energy (ddg.energies.cross_section, Eq. R): the
-    edges' stretching under twist, less what the cross-section's transverse bending relieves."""
+    """The DAR plus its cross-section as a field (ddg.energies.cross_section, Eq. X): `modes` DOFs
+    per edge after the twist angle (node_stride 4 + modes), zero on the clamped edges."""
 
     name = "ribbon-cross-section"
+    edge_fields = 2
 
-    def __init__(self, strip: Strip, nodes: int = 101):
+    def __init__(self, strip: Strip, nodes: int = 101, modes: int | None = None):
+        if modes is not None:
+            self.edge_fields = modes
         super().__init__(strip, nodes)
-        self.cross_section_coefficients = cross_section_coefficients(strip.young_modulus, strip.thickness,
-                                                                     strip.width, strip.poisson_ratio)
+        self.modes = CrossSectionModes(strip.width, strip.thickness, strip.young_modulus, strip.poisson_ratio,
+                                       self.edge_fields)
+        stride = self.node_stride
+        self.bandwidth = 2 * stride + 2  # a stencil spans x_{i-1} .. x_{i+1}: 2 stride + 3 DOFs
+        # where the stencil's rod strains (over the rod's 11 DOFs) and its edges' modes sit in its block
+        self._rod_place = np.array([a + (a // 4) * (stride - 4) for a in range(11)])
+        n = self.edge_fields
+        self._mode_place = np.r_[4 + np.arange(n), stride + 4 + np.arange(n)]
 
-    def coupled_terms(self, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
+    def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
+        c = q[self.field_dofs]
         eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
-        energy, first, second = cross_section_density(eps, kappa_n, tau, self.voronoi_lengths,
-                                                      self.cross_section_coefficients)
+        energy, first, second = field_density(eps, kappa_n, tau, c[:-1], c[1:], self.voronoi_lengths, self.modes)
         if gradient:
-            add_stretch_strain_terms(self, x, m1, m2, (eps_grad, eps_hess), (_KAPPA_N, _TAU), first, second, grad,
-                                     band, hessian)
+            count, n = len(eps), self.edge_fields
+            size = 2 * self.node_stride + 3
+            grads, hessians = stencil_strain_blocks(x, m1, m2)
+            local_grads = np.zeros((count, 3 + 2 * n, size))
+            local_hess = np.zeros((count, 3, size, size))
+            place = self._rod_place
+            local_grads[:, 0, place] = eps_grad
+            local_grads[:, 1:3, place] = grads[:, [_KAPPA_N, _TAU]]
+            local_grads[:, 3 + np.arange(2 * n), self._mode_place] = 1.0
+            local_hess[:, 0][:, place[:, None], place[None, :]] = eps_hess
+            local_hess[:, 1:3][:, :, place[:, None], place[None, :]] = hessians[:, [_KAPPA_N, _TAU]]
+            add_local_terms(self.node_stride * np.arange(count), local_grads,
+                            np.concatenate([local_hess, np.zeros((count, 2 * n, size, size))], axis=1),
+                            first, second, self.n_dof, grad, band, hessian)
         return {"cross_section": float(energy.sum())}
+
+    def cross_section(self, q: np.ndarray) -> np.ndarray:
+        """The modes c^e (M - 1, n) of each edge's cross-section (c_1: transverse curvature, 1/m)."""
+        return q[self.field_dofs]
+
+    # the modes' units in the metric, residuals, steps and masses: c_j W^(2j - 1) is an angle
+    def _mode_units(self) -> np.ndarray:
+        return self.strip.width ** (2 * np.arange(1, self.edge_fields + 1) - 1)
+
+    def eigenvalue_metric(self):
+        """The rod's metric plus h int (w_j - mean w_j)^2 dy / W per mode (the cross-section's
+        inertia, as the twist angle's h W^2 / 12)."""
+        metric, unit = super().eigenvalue_metric()
+        full = np.zeros(self.n_dof)
+        full[self.free] = metric
+        modes = self.modes
+        w = self.strip.width
+        mean = modes.m[1:] / w
+        variance = (np.diag(modes.S)[1:] - w * mean**2) / w
+        full[self.field_dofs] = self.centerline.spacing * variance[None, :]
+        return full[self.free], unit
+
+    def residual_scale(self) -> np.ndarray:
+        scale = super().residual_scale()
+        scale[self.field_dofs] = (self.strip.bending_stiffness / self.strip.length * self._mode_units())[None, :]
+        return scale
+
+    def length_scale(self) -> np.ndarray:
+        scale = super().length_scale()
+        scale[self.field_dofs] = (1.0 / self._mode_units())[None, :]
+        return scale
+
+    def mass(self) -> np.ndarray:
+        """The rod's masses plus rho b h int w_j^2 dy per mode."""
+        mass = super().mass()
+        s = self.strip
+        mass[self.field_dofs] = (s.density * s.thickness * self.centerline.spacing * np.diag(self.modes.S)[1:])[None, :]
+        return mass
 
 
 class WunderlichRibbon(RibbonModel):
@@ -125,7 +187,7 @@ class WunderlichRibbon(RibbonModel):
         return wunderlich_pair_density(kappa_n, tau, self.voronoi_lengths, self.pair_lengths, s.width,
                                        s.bending_stiffness, s.twisting_stiffness, self.voronoi_lengths / self.zeta)
 
-    def coupled_terms(self, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
+    def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
         energy, first, second, v = self.pair_terms(kappa_n, tau)
         self.largest_ruling_rate = float(np.max(np.abs(v))) if len(v) else 0.0
         total = float(energy.sum()) if np.all(np.isfinite(energy)) else math.inf

@@ -182,33 +182,34 @@ def write_index(out: Path, model: str = "plate") -> None:
                       if est else ["-", "-", "-"])
         lines.append(f"| {name} | {', '.join(map(str, e['meshes']))} | {', '.join(map(str, e['triangles']))} | "
                      f"{' | '.join(cells)} | {e['wall_time_s']:.0f} |")
-    lines += ["", *agreement_lines(index)]
+    lines += ["", *agreement_lines(out, model)]
     atomic_write_text(out / "README.md", "\n".join(lines) + "\n")
 
 
-def agreement_lines(index: dict) -> list[str]:
-    """Markdown lines comparing each indexed study with the shell's (data/fem_gold) by the gold's
-    rule: |DDG - FEM| against the sum of the two error bars."""
+def agreement_lines(out: Path, model: str) -> list[str]:
+    """Markdown lines comparing each stored study in `out` with the shell's (data/fem_gold) by the
+    gold's rule (validation.claims.threshold_agreement): |DDG - FEM| against the sum of the bars."""
     from fem_reference.gold import all_scenes
+
+    from .claims import threshold_agreement
+
+    def cell(estimate):
+        return "-" if estimate is None else f"{estimate.value:.4f} +- {_fmt(estimate.error_bar)}"
 
     lines = ["Against the shell's studies (data/fem_gold; the same error-bar rule): |diff|/combined is |DDG - FEM| "
              "over the sum of the two error bars, at most 1 where they agree.", "",
              "| scene | DDG dW1/L | FEM dW1/L | \\|diff\\|/combined | DDG dW2/L | FEM dW2/L | \\|diff\\|/combined |",
              "|---|---:|---:|---:|---:|---:|---:|"]
     for name, compression, width, _ in all_scenes():
-        if name not in index:
+        mine = load_study(model, compression, width, root=out, name=name)
+        if mine is None:
             continue
         fem = load_study("fem", compression, width, name=name)
         cells = []
         for key in ("dW1", "dW2"):
-            mine = index[name].get(key)
-            theirs = getattr(fem, key) if fem is not None else None
-            cells.append(f"{_fmt(mine['value'])} +- {_fmt(mine['error_bar'])}" if mine else "-")
-            cells.append(f"{theirs.value:.4f} +- {theirs.error_bar:.4f}" if theirs else "-")
-            if mine and theirs and mine["error_bar"] is not None:
-                cells.append(f"{abs(mine['value'] - theirs.value) / (mine['error_bar'] + theirs.error_bar):.2f}")
-            else:
-                cells.append("-")
+            agreement = threshold_agreement(mine, fem, key) if fem is not None else None
+            cells += [cell(mine.threshold(key)), cell(fem.threshold(key) if fem is not None else None),
+                      "-" if agreement is None else f"{agreement.difference / agreement.combined_error_bar:.2f}"]
         lines.append(f"| {name} | {' | '.join(cells)} |")
     return lines
 

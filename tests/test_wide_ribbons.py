@@ -70,11 +70,17 @@ def test_ribbons_tend_to_the_rod_as_the_strip_narrows(model, narrow_runs):
     falls at each halving of W, below 2e-3 at W^2 / (b L) = 0.18 and 2e-4 at 0.046, and dW2 is the
     rod's within 1e-3 at the two narrowest widths. Measured gaps of dW1 at 0.74 / 0.18 / 0.046:
     sano-wada 8.9e-3 / 7.6e-4 / 6.5e-5, trapeze 1.2e-3 / 4.5e-4 / 4.4e-5, wunderlich 9.1e-3 /
-    7.6e-4 / 6.5e-5 (bounds ~2.5-3x the values at the two narrow widths); dW2 gaps <= 7e-4."""
+    7.6e-4 / 6.5e-5, cross-section 5.2e-3 / 4.9e-4 / 4.1e-5 (bounds ~2.5-3x the values at the two
+    narrow widths; the cross-section's largest gap is over the first bound, but it is not asserted);
+    dW2 gaps <= 8.9e-4."""
     gaps = []
     for w in NARROW_WIDTHS:
         rod, ribbon = narrow_runs[("rod", w)], narrow_runs[(model, w)]
-        assert ribbon["converged"], ribbon["message"]
+        # the cross-section ribbon at W/L = 1/40 folds at dW/L = 0.8254, 98.1 % of dW_max, after
+        # both thresholds (measured); any other stop fails here
+        folded_near_max = (ribbon["status"] == "stopped" and "folds" in ribbon["message"]
+                           and ribbon["resolved_up_to_dW_over_L"] > 0.95 * rod["dW_max_over_L"])
+        assert ribbon["converged"] or folded_near_max, ribbon["message"]
         gaps.append(abs(ribbon["dW1_over_L"] - rod["dW1_over_L"]))
     assert gaps[0] > gaps[1] > gaps[2], gaps
     assert gaps[1] < 2e-3 and gaps[2] < 2e-4, gaps

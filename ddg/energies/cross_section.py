@@ -5,9 +5,10 @@ an unknown field along the strip instead of eliminated point by point).
 
 Derivation. A strip of width W, thickness b, Young's modulus E, Poisson ratio nu, plate stiffness
 D = E b^3 / (12 (1 - nu^2)), has centreline strains that vary slowly along it (arclength x): the
-stretch eps of the mid-width fibre, the normal curvature kappa (the rod's kappa_n), the twist tau
-and the in-plane curvature kappa_g. Across the width, y in [-W/2, W/2], the cross-section deflects
-by w(x, y) normal to the strip, with w = 0 on the centreline. In the long-wavelength limit the
+stretch eps, the normal curvature kappa (the rod's kappa_n), the twist tau and the in-plane
+curvature kappa_g. Across the width, y in [-W/2, W/2], the cross-section deflects by w(x, y) normal
+to the strip; the centreline is the line of the cross-sections' centroids, int w dy = 0 (the
+rod's, and Audoly and Neukirch's, convention: eps is then the mean strain of the fibres). In the long-wavelength limit the
 transverse membrane stress vanishes (the long edges are free), and the Foppl-von Karman strip
 stores, per unit length,
 
@@ -19,17 +20,19 @@ tau^2 y^2 / 2 (the trapeze effect, ddg.energies.trapeze) and a fibre lifted by w
 curvature kappa shortens by kappa w. The odd part of w relieves nothing (kappa_g keeps the rod's
 E b W^3 / 12). The even part is written in n modes,
 
-    w_yy = sum_j c_j y^(2j - 2),  w = sum_j c_j B_j(y),  B_j = y^(2j) / ((2j - 1) 2j),  j = 1 .. n,
+    w_yy = sum_j c_j y^(2j - 2),  w = sum_j c_j (B_j(y) - <B_j>),  B_j = y^(2j) / ((2j - 1) 2j),  j = 1 .. n,
 
-c_1 the transverse curvature on the centreline. With phi = (B_1, B_1, ..., B_n) and
-v = (tau^2, -kappa c_1, ..., -kappa c_n), e = eps - kappa_g y + phi . v, and (F) integrates to the
+c_1 the transverse curvature at mid-width, <.> the mean over the width. With
+phi = (B_1, B_1 - <B_1>, ..., B_n - <B_n>) and v = (tau^2, -kappa c_1, ..., -kappa c_n),
+e = eps - kappa_g y + phi . v, and (F) integrates to the
 rod's energy (E b W eps^2 / 2, EI kappa^2 / 2 with EI = E W b^3 / 12, GJ tau^2 / 2 with
 GJ = 2 D (1 - nu) W, E b W^3 kappa_g^2 / 24) plus this module's density
 
     f = E b [eps m . v + v . S v / 2] + (D / 2) [c . P c + 2 nu kappa p . c + nu^2 W kappa^2]
         + D (1 - nu) c' . Q c',                                                                 (X)
 
-    m_a = int phi_a,  S_ab = int phi_a phi_b,  P_ij = int y^(2i + 2j - 4),  p_j = int y^(2j - 2),
+    m_a = int phi_a (= 0 but for m_1 = W^3 / 24),  S_ab = int phi_a phi_b,  P_ij = int y^(2i + 2j - 4),
+    p_j = int y^(2j - 2),
     Q_ij = int y^(2i + 2j - 2) / ((2i - 1)(2j - 1))   (integrals over the width),
 
 c' = dc/dx: the last term is the twisting energy of a cross-section whose shape changes along
@@ -40,8 +43,8 @@ are dropped: next to the c'^2 term they are of relative size W^2 / (60 l^2) at a
 Its limits, all exact:
 - c = 0 (the cross-section kept straight): f = E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640, the
   trapeze ribbon (m_1 = W^3 / 24, S_11 = W^5 / 320);
-- tau = 0, nu = 0: f is a positive quadratic in c with its minimum c = 0, the rod and the exact
-  elastica (for nu > 0 an untwisted strip bends anticlastically, c_1 = -nu kappa while
+- tau = 0, nu = 0: f is a positive quadratic in c with its minimum c = 0 (the centroid convention
+  removes any eps kappa c coupling), the rod and the exact elastica (for nu > 0 an untwisted strip bends anticlastically, c_1 = -nu kappa while
   kappa W^2 / b is small: the rod's EI; the stretching stiffens it to D W for kappa W^2 / b
   large, Ashwell's transition);
 - W^2 kappa / b -> 0 or W^2 tau / b -> 0: the stretching terms vanish as W^5, c_1 -> -nu kappa,
@@ -107,8 +110,12 @@ class CrossSectionModes:
         # phi = (B_1, B_1 .. B_n): powers and denominators of y^(2j) / ((2j - 1) 2j)
         powers = np.r_[2, 2 * j]
         denominators = np.r_[2.0, (2 * j - 1) * 2.0 * j]
-        m = _width_integral(powers, w) / denominators
-        s = _width_integral(powers[:, None] + powers[None, :], w) / (denominators[:, None] * denominators[None, :])
+        raw_m = _width_integral(powers, w) / denominators
+        raw_s = _width_integral(powers[:, None] + powers[None, :], w) / (denominators[:, None] * denominators[None, :])
+        # the modes about their means (the centroid convention): phi_a - <phi_a> for a >= 1
+        shift = np.r_[0.0, raw_m[1:] / w]
+        m = raw_m - w * shift
+        s = raw_s - np.outer(raw_m, shift) - np.outer(shift, raw_m) + w * np.outer(shift, shift)
         p = _width_integral(2 * j - 2, w)
         big_p = _width_integral((2 * j - 2)[:, None] + (2 * j - 2)[None, :], w)
         odd = 2 * j - 1
@@ -157,8 +164,9 @@ def _point_density(eps, k, t, c, modes: CrossSectionModes):
     idx = np.arange(n)
     jac[:, 2 + idx, 3 + idx] = -k[:, None]
     value = eb * (eps * (v @ modes.m) + 0.5 * np.einsum("na,na->n", v, sv))
-    first = np.einsum("naz,na->nz", jac, g_w)
-    second = np.einsum("naz,ab,nby->nzy", jac, h_g, jac)
+    jac_t = jac.transpose(0, 2, 1)
+    first = (jac_t @ g_w[:, :, None])[:, :, 0]
+    second = jac_t @ (h_g @ jac)
     second[:, 2, 2] += 2.0 * g_w[:, 1]            # d2 (tau^2) / dtau2
     second[:, 1, 3 + idx] += -g_w[:, 2:]           # d2 (-kappa c_j) / dkappa dc_j
     second[:, 3 + idx, 1] += -g_w[:, 2:]
@@ -183,18 +191,15 @@ def field_density(eps, kappa, tau, c_before, c_after, voronoi_lengths, modes: Cr
     ell = np.asarray(voronoi_lengths, dtype=float)
     c_mean = 0.5 * (c_before + c_after)
     f, f_z, f_zz = _point_density(eps, kappa / ell, tau / ell, c_mean, modes)
-    count = len(ell)
-    size = 3 + 2 * n
-    # u -> z: eps, kappa / l, tau / l, (c_before + c_after) / 2
-    scale = np.zeros((count, 3 + n, size))
-    scale[:, 0, 0] = 1.0
-    scale[:, 1, 1] = scale[:, 2, 2] = 1.0 / ell
-    idx = np.arange(n)
-    scale[:, 3 + idx, 3 + idx] = 0.5
-    scale[:, 3 + idx, 3 + n + idx] = 0.5
+    # u -> z: eps, kappa / l, tau / l, (c_before + c_after) / 2, a diagonal scaling then a copy
+    scale = np.empty((len(ell), 3 + n))
+    scale[:, 0] = ell
+    scale[:, 1:3] = 1.0
+    scale[:, 3:] = 0.5 * ell[:, None]
+    z_of_u = np.r_[0, 1, 2, 3 + np.arange(n), 3 + np.arange(n)]
     energy = ell * f
-    first = ell[:, None] * np.einsum("nzu,nz->nu", scale, f_z)
-    second = ell[:, None, None] * np.einsum("nzu,nzy,nyv->nuv", scale, f_zz, scale)
+    first = (scale * f_z)[:, z_of_u]
+    second = (f_zz * (scale[:, :, None] * scale[:, None, :] / ell[:, None, None]))[:, z_of_u][:, :, z_of_u]
     # the cross-section's change along the strip: D (1 - nu) dc . Q dc / l
     g = modes.plate * (1.0 - modes.poisson_ratio)
     dc = c_after - c_before

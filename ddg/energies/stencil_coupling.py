@@ -114,3 +114,66 @@ def pair_blocks(grads: np.ndarray, hessians: np.ndarray, components: tuple[int, 
     ph[:, :c, :s, :s] = hessians[:-1][:, idx]
     ph[:, c:, 4:4 + s, 4:4 + s] = hessians[1:][:, idx]
     return pg, ph
+
+
+@njit(cache=True)
+def add_placed_terms(bases, place, grads, hessians, unit_place, first, second, n_dof, grad, band, want_hessian):
+    """add_local_terms for terms whose first h strains have derivatives over the rod's 11 stencil
+    DOFs and whose other u strains are DOFs themselves (a model with more DOFs per edge: the
+    cross-section's modes, ddg.models.wide_ribbons.CrossSectionRibbon).
+
+    bases (P,): first DOF of each term's block; place (11,): where the rod's stencil DOFs sit in the
+    block; grads (P, h, 11) and hessians (P, h, 11, 11): the h strains' derivatives; unit_place (u,):
+    where the other strains sit in the block (each is one DOF: unit gradient, no Hessian); first
+    (P, h + u) and second (P, h + u, h + u): the density's partials. Every block position must be
+    increasing with its index in place and unit_place merged (the band takes r >= c)."""
+    n_terms, h, size = grads.shape
+    u = unit_place.shape[0]
+    mixed = np.empty((h, size))
+    for p in range(n_terms):
+        base = bases[p]
+        for a in range(size):
+            total = 0.0
+            for c in range(h):
+                total += first[p, c] * grads[p, c, a]
+            grad[base + place[a]] += total
+        for j in range(u):
+            grad[base + unit_place[j]] += first[p, h + j]
+        if not want_hessian:
+            continue
+        # rod x rod: sum_c first_c H_c + sum_cd second_cd g_c g_d^T, via mixed_d = sum_c second_cd g_c
+        for d in range(h):
+            for a in range(size):
+                total = 0.0
+                for c in range(h):
+                    total += second[p, c, d] * grads[p, c, a]
+                mixed[d, a] = total
+        for a in range(size):
+            ra = place[a]
+            for b in range(size):
+                rb = place[b]
+                if rb > ra:
+                    continue
+                total = 0.0
+                for c in range(h):
+                    total += first[p, c] * hessians[p, c, a, b] + mixed[c, a] * grads[p, c, b]
+                band[(ra - rb) * n_dof + base + rb] += total
+        # rod x unit and unit x unit
+        for j in range(u):
+            rj = unit_place[j]
+            for a in range(size):
+                total = 0.0
+                for c in range(h):
+                    total += second[p, c, h + j] * grads[p, c, a]
+                ra = place[a]
+                if ra >= rj:
+                    band[(ra - rj) * n_dof + base + rj] += total
+                else:
+                    band[(rj - ra) * n_dof + base + ra] += total
+            for i in range(j + 1):
+                ri = unit_place[i]
+                value = second[p, h + j, h + i]
+                if rj >= ri:
+                    band[(rj - ri) * n_dof + base + ri] += value
+                else:
+                    band[(ri - rj) * n_dof + base + rj] += value

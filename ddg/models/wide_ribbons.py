@@ -31,7 +31,7 @@ import numpy as np
 
 from ..energies.cross_section import CrossSectionModes, field_density
 from ..energies.sadowsky import check_zeta
-from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_strain_blocks,
+from ..energies.stencil_coupling import (add_local_terms, add_placed_terms, pair_blocks, stencil_strain_blocks,
                                          stencil_stretch)
 from ..energies.trapeze import trapeze_coefficients, trapeze_density
 from ..energies.wunderlich import POLE, wunderlich_pair_density
@@ -115,20 +115,11 @@ class CrossSectionRibbon(RodModel):
         eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
         energy, first, second = field_density(eps, kappa_n, tau, c[:-1], c[1:], self.voronoi_lengths, self.modes)
         if gradient:
-            count, n = len(eps), self.edge_fields
-            size = 2 * self.node_stride + 3
             grads, hessians = stencil_strain_blocks(x, m1, m2)
-            local_grads = np.zeros((count, 3 + 2 * n, size))
-            local_hess = np.zeros((count, 3, size, size))
-            place = self._rod_place
-            local_grads[:, 0, place] = eps_grad
-            local_grads[:, 1:3, place] = grads[:, [_KAPPA_N, _TAU]]
-            local_grads[:, 3 + np.arange(2 * n), self._mode_place] = 1.0
-            local_hess[:, 0][:, place[:, None], place[None, :]] = eps_hess
-            local_hess[:, 1:3][:, :, place[:, None], place[None, :]] = hessians[:, [_KAPPA_N, _TAU]]
-            add_local_terms(self.node_stride * np.arange(count), local_grads,
-                            np.concatenate([local_hess, np.zeros((count, 2 * n, size, size))], axis=1),
-                            first, second, self.n_dof, grad, band, hessian)
+            strain_grads = np.concatenate([eps_grad[:, None], grads[:, [_KAPPA_N, _TAU]]], axis=1)
+            strain_hess = np.concatenate([eps_hess[:, None], hessians[:, [_KAPPA_N, _TAU]]], axis=1)
+            add_placed_terms(self.node_stride * np.arange(len(eps)), self._rod_place, strain_grads, strain_hess,
+                             self._mode_place, first, second, self.n_dof, grad, band, hessian)
         return {"cross_section": float(energy.sum())}
 
     def cross_section(self, q: np.ndarray) -> np.ndarray:

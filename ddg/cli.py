@@ -40,9 +40,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="rod (DAR, default), plate (DEP on a triangle mesh), plate-midedge (mid-edge "
                           "Kirchhoff plate with the material's Poisson ratio), ribbon (Sadowsky, Eq. A.5), "
                           "ribbon-sano-wada (Eq. A.5 with zeta^2 = (1 - nu) W^4 / (60 b^2)), ribbon-trapeze "
-                          "(the rod plus the edges' stretching under twist), ribbon-cross-section (the rod plus what the "
-                          "cross-section keeps of that stretching after bending to its least-energy shape, Audoly "
-                          "and Neukirch 2021) or ribbon-wunderlich (Eq. A.2)")
+                          "(the rod plus the edges' stretching under twist), ribbon-cross-section (the rod plus its "
+                          "cross-section as a field of two modes, which bends to relieve that stretching; after "
+                          "Audoly and Neukirch 2021) or ribbon-wunderlich (Eq. A.2)")
     sim.add_argument("--zeta", type=float, default=None,
                      help="ribbon: regularisation length zeta of Eq. (A.5) in metres (default 1e4 L); "
                           "ribbon-wunderlich: the same for its ruling slope (default the Sano-Wada value)")

@@ -8,7 +8,8 @@ D = E b^3 / (12 (1 - nu^2)), has centreline strains that vary slowly along it (a
 stretch eps, the normal curvature kappa (the rod's kappa_n), the twist tau and the in-plane
 curvature kappa_g. Across the width, y in [-W/2, W/2], the cross-section deflects by w(x, y) normal
 to the strip; the centreline is the line of the cross-sections' centroids, int w dy = 0 (the
-rod's, and Audoly and Neukirch's, convention: eps is then the mean strain of the fibres). In the long-wavelength limit the
+rod's, and Audoly and Neukirch's, convention: eps is then the mean strain of the fibres).
+In the long-wavelength limit the
 transverse membrane stress vanishes (the long edges are free), and the Foppl-von Karman strip
 stores, per unit length,
 
@@ -44,7 +45,8 @@ Its limits, all exact:
 - c = 0 (the cross-section kept straight): f = E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640, the
   trapeze ribbon (m_1 = W^3 / 24, S_11 = W^5 / 320);
 - tau = 0, nu = 0: f is a positive quadratic in c with its minimum c = 0 (the centroid convention
-  removes any eps kappa c coupling), the rod and the exact elastica (for nu > 0 an untwisted strip bends anticlastically, c_1 = -nu kappa while
+  removes any eps kappa c coupling), the rod and the exact elastica (for nu > 0 an
+  untwisted strip bends anticlastically, c_1 = -nu kappa while
   kappa W^2 / b is small: the rod's EI; the stretching stiffens it to D W for kappa W^2 / b
   large, Ashwell's transition);
 - W^2 kappa / b -> 0 or W^2 tau / b -> 0: the stretching terms vanish as W^5, c_1 -> -nu kappa,

@@ -2,7 +2,8 @@
 
 DOF vector q = [x_0, theta^0, x_1, theta^1, ..., theta^{M-2}, x_{M-1}] (Eq. 1), 4M - 1
 entries (a model with `edge_fields` more DOFs per edge puts them after each theta^j:
-node_stride = 4 + edge_fields, ddg.models.wide_ribbons.CrossSectionRibbon). Energy: stretching (Eq. 6a), bending with both material curvatures (Eqs. 3-4, 6b)
+node_stride = 4 + edge_fields, ddg.models.wide_ribbons.CrossSectionRibbon). Energy: stretching
+(Eq. 6a), bending with both material curvatures (Eqs. 3-4, 6b)
 and twisting with reference twist (Eqs. 5, 6c). Clamps (section 4): x_0, theta^0, x_1 and
 x_{M-2}, theta^{M-2}, x_{M-1} are prescribed, 14 DOFs; the clamped edges straddle the clamp
 points (see ddg.geometry.centerline) so the free length is exactly L. The material frame

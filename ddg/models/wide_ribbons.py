@@ -39,7 +39,8 @@ from ..geometry.strip import Strip
 from .ribbon import RibbonModel
 from .rod import RodModel
 
-__all__ = ["SanoWadaRibbon", "TrapezeRibbon", "CrossSectionRibbon", "WunderlichRibbon", "sano_wada_zeta", "WIDE_RIBBONS"]
+__all__ = ["SanoWadaRibbon", "TrapezeRibbon", "CrossSectionRibbon", "WunderlichRibbon", "sano_wada_zeta",
+           "WIDE_RIBBONS"]
 
 #: Strain indices of rod_curvature's (kappa_n, kappa_g, tau) order used here.
 _KAPPA_N, _TAU = 0, 2

@@ -136,13 +136,14 @@ def test_straight_cross_section_is_the_trapeze_ribbon(nu):
     eps, kappa, tau = 1e-3 * rng.standard_normal(n), 0.1 * rng.standard_normal(n), 0.2 * rng.standard_normal(n)
     dl = np.full(n, 0.01)
     zero = np.zeros((n, 2))
-    energy, first, second = field_density(eps, kappa, tau, zero, zero, dl, CrossSectionModes(w, b, e, nu, 2))
+    energy, first, second = field_density(eps, kappa, 0.1 * kappa, tau, zero, zero, dl,
+                                          CrossSectionModes(w, b, e, nu, 2))
     t_energy, t_first, t_second = trapeze_density(eps, tau, dl, *trapeze_coefficients(e, b, w))
     plate = e * b**3 / (12.0 * (1.0 - nu * nu))
     straight = 0.5 * plate * nu * nu * w * kappa**2 / dl
     assert np.allclose(energy, t_energy + straight, rtol=1e-12, atol=0)
-    assert np.allclose(first[:, [0, 2]], t_first, rtol=1e-12, atol=0)
-    assert np.allclose(second[:, [0, 2]][:, :, [0, 2]], t_second, rtol=1e-12, atol=1e-300)
+    assert np.allclose(first[:, [0, 3]], t_first, rtol=1e-12, atol=0)
+    assert np.allclose(second[:, [0, 3]][:, :, [0, 3]], t_second, rtol=1e-12, atol=1e-300)
 
 
 def test_untwisted_strip_keeps_a_straight_cross_section_for_nu_zero():
@@ -154,24 +155,24 @@ def test_untwisted_strip_keeps_a_straight_cross_section_for_nu_zero():
     eps, c, relieved = local_optimum(kappa, np.zeros_like(kappa), shape)
     assert np.allclose(c, 0.0, atol=1e-12) and np.allclose(relieved, 0.0, atol=1e-12)
     n = len(kappa)
-    energy, first, _ = field_density(np.full(n, -1e-3), kappa * 0.01, np.zeros(n), np.zeros((n, 2)), np.zeros((n, 2)),
-                                     np.full(n, 0.01), shape)
+    energy, first, _ = field_density(np.full(n, -1e-3), kappa * 0.01, kappa * 0.005, np.zeros(n), np.zeros((n, 2)),
+                                     np.zeros((n, 2)), np.full(n, 0.01), shape)
     assert np.all(energy == 0.0) and np.all(first == 0.0)
 
 
 @pytest.mark.parametrize("nu", [0.0, 0.3])
 def test_field_density_derivatives_match_finite_differences(nu):
-    """E_i's partials in (eps, kappa, tau, c^{i-1}, c^i) against central differences at random
-    strains (relative step 1e-6): measured errors below 4e-7 (gradient) and 1e-9 (Hessian)."""
+    """E_i's partials in (eps, kappa, kappa_g, tau, c^{i-1}, c^i) against central differences at
+    random strains (relative step 1e-6): measured errors below 4e-7 (gradient) and 1e-9 (Hessian)."""
     rng = np.random.default_rng(11)
     shape = CrossSectionModes(0.05, 1e-3, 1e9, nu, 2)
     n = 6
-    u = np.concatenate([1e-3 * rng.standard_normal((n, 1)), 0.1 * rng.standard_normal((n, 2)),
+    u = np.concatenate([1e-3 * rng.standard_normal((n, 1)), 0.1 * rng.standard_normal((n, 3)),
                         rng.standard_normal((n, 4)) * [10.0, 1e3, 10.0, 1e3]], axis=1)
     dl = rng.uniform(0.005, 0.015, n)
 
     def density(v):
-        return field_density(v[:, 0], v[:, 1], v[:, 2], v[:, 3:5], v[:, 5:7], dl, shape)
+        return field_density(v[:, 0], v[:, 1], v[:, 2], v[:, 3], v[:, 4:6], v[:, 6:8], dl, shape)
 
     _, first, second = density(u)
     for a in range(u.shape[1]):
@@ -188,3 +189,57 @@ def test_modes_outside_their_range_are_refused():
     for modes in (0, 5, 1.5):
         with pytest.raises(ValueError, match="modes"):
             CrossSectionModes(0.05, 1e-3, 1e9, 0.0, modes)
+
+
+def test_fibre_strains_of_a_surface_built_from_the_rods_frames_fix_the_signs():
+    """The signs of Eq. F in the rod's frame: a surface r(s, y) = X(s) + y m2 + w m1, w = c (y^2/2 -
+    W^2/24), built on a bent, in-plane bent and twisted discrete centreline (1001 nodes), has fibre
+    strains e(y) - tau^2 y^2/2 = -kappa_g y - kappa_n w + (w_s - tau y)^2/2 - tau^2 y^2/2 + ...: the
+    fit gives +1 for -kappa_g y and -kappa_n w and -1/2 for tau c' y^3 (the map's own shear; the
+    in-plane warping that removes it leaves Gauss's -tau c' y^3 / 3): the second fundamental form's
+    k_xy is w_xy - tau, whose -2 tau w_xy is the odd strain of Eq. X. Measured coefficients
+    0.9985, 0.9912, -0.5091 (of y^3), 1.015 (of tau c' y W^2 / 24); bounds 3.3x the
+    distances from 1, 1, -1/2, 1 (13x for kappa_g, whose fit is the tightest)."""
+    import ddg
+    from ddg.energies.rod_curvature import material_curvatures
+    from ddg.energies.rod_twist import discrete_twist
+    from ddg.models.wide_ribbons import CrossSectionRibbon
+
+    length, width = 1.0, 0.02
+    model = CrossSectionRibbon(ddg.Strip(length=length, width=width, thickness=1e-4, young_modulus=1e9), 1001,
+                               modes=1)
+    s_e, h = model.centerline.edge_arclength, model.centerline.spacing
+    phi = 0.8 * np.sin(2 * np.pi * s_e / length)
+    turn = 0.5 * np.sin(np.pi * s_e / length + 0.3)
+    t = np.stack([np.cos(phi) * np.cos(turn), np.cos(phi) * np.sin(turn), np.sin(phi)], axis=1)
+    x = np.zeros((model.nodes, 3))
+    x[0] = [-0.5 * h, 0.0, 0.0]
+    x[1:] = x[0] + h * np.cumsum(t, axis=0)
+    rest = model.reset()
+    for a in np.linspace(0.0, 1.0, 41)[1:]:  # committed in small steps: frames transported smoothly
+        q = rest.copy()
+        q[model.node_dofs] = (1 - a) * rest[model.node_dofs] + a * x
+        q[model.theta_dofs] = a * 1.5 * np.sin(3 * np.pi * s_e / length)
+        model.commit(q)
+    _, _, m1, m2, m_ref = model.frames(q)
+    kappa_n, kappa_g = material_curvatures(x, m1, m2)
+    tau = discrete_twist(q[model.theta_dofs], m_ref)
+    ell = model.voronoi_lengths
+    c = 30.0 * np.sin(2 * np.pi * s_e / length + 0.7)
+    mid = 0.5 * (x[1:] + x[:-1])
+    columns, values = [], []
+    for i in range(100, model.nodes - 100, 19):
+        k_n, k_g, tw = kappa_n[i - 1] / ell[i - 1], kappa_g[i - 1] / ell[i - 1], tau[i - 1] / ell[i - 1]
+        c_bar, c_prime = 0.5 * (c[i - 1] + c[i]), (c[i] - c[i - 1]) / ell[i - 1]
+        base = np.linalg.norm(mid[i] - mid[i - 1])
+        for y in np.linspace(-width / 2, width / 2, 21):
+            shape = y * y / 2 - width**2 / 24
+            before = mid[i - 1] + y * m2[i - 1] + c[i - 1] * shape * m1[i - 1]
+            after = mid[i] + y * m2[i] + c[i] * shape * m1[i]
+            strain = np.linalg.norm(after - before) / base - 1.0
+            columns.append([-k_g * y, -k_n * c_bar * shape, tw * c_prime * y**3, tw * c_prime * y * width**2 / 24,
+                            ((c[i] - c[i - 1]) * shape) ** 2 / (2 * base**2)])
+            values.append(strain - tw * tw * y * y / 2)
+    fit = np.linalg.lstsq(np.array(columns), np.array(values), rcond=None)[0]
+    assert fit[0] == pytest.approx(1.0, abs=0.02) and fit[1] == pytest.approx(1.0, abs=0.03)
+    assert fit[2] == pytest.approx(-0.5, abs=0.03) and fit[3] == pytest.approx(1.0, abs=0.05)

@@ -13,33 +13,43 @@ In the long-wavelength limit the
 transverse membrane stress vanishes (the long edges are free), and the Foppl-von Karman strip
 stores, per unit length,
 
-    U = int { (E b / 2) e^2 + (D / 2) [kappa^2 + w_yy^2 + 2 nu kappa w_yy + 2 (1 - nu) (tau + w_xy)^2] } dy,
-    e(y) = eps - kappa_g y + tau^2 y^2 / 2 - kappa w(y),                                        (F)
+    U = int { (E b / 2) e^2 + (D / 2) [kappa^2 + w_yy^2 + 2 nu kappa w_yy + 2 (1 - nu) (w_xy - tau)^2] } dy,
+    e_yy = -K = (w_xy - tau)^2 - (kappa + w_xx) w_yy,                                          (F)
 
-e being the axial strain of the fibre at y: the helix of a twisted strip lengthens its fibres by
-tau^2 y^2 / 2 (the trapeze effect, ddg.energies.trapeze) and a fibre lifted by w on a centreline of
-curvature kappa shortens by kappa w. The odd part of w relieves nothing (kappa_g keeps the rod's
-E b W^3 / 12). The even part is written in n modes,
+e being the axial strain of the fibre at y, whose second derivative across the width is minus the
+Gaussian curvature K of the deformed surface (compatibility with e_yy = e_xy = 0), e = eps -
+kappa_g y at y = 0 (the centreline's stretch and in-plane curvature). To first order in the
+derivatives along x, e(y) = eps - kappa_g y + tau^2 y^2 / 2 - kappa w(y) - 2 tau int int w_xy:
+the helix of a twisted strip lengthens its fibres by tau^2 y^2 / 2 (the trapeze effect,
+ddg.energies.trapeze), a fibre lifted by w on a centreline of curvature kappa shortens by kappa w,
+and a cross-section that changes along the strip shears the twist into an odd strain (below). The
+signs are those of the rod's frame (m1 the normal, y along m2, tau = m1' . m2), checked on a
+surface built from the rod's frames (tests/test_cross_section.py). The odd part of w relieves
+nothing (kappa_g keeps the rod's E b W^3 / 12). The even part is written in n modes,
 
     w_yy = sum_j c_j y^(2j - 2),  w = sum_j c_j (B_j(y) - <B_j>),  B_j = y^(2j) / ((2j - 1) 2j),  j = 1 .. n,
 
 c_1 the transverse curvature at mid-width, <.> the mean over the width. With
-phi = (B_1, B_1 - <B_1>, ..., B_n - <B_n>) and v = (tau^2, -kappa c_1, ..., -kappa c_n),
-e = eps - kappa_g y + phi . v, and (F) integrates to the
+phi = (B_1, B_1 - <B_1>, ..., B_n - <B_n>), v = (tau^2, -kappa c_1, ..., -kappa c_n) and
+psi_j = 2 y^(2j + 1) / ((2j - 1) 2j (2j + 1)), e = eps - kappa_g y + phi . v - tau c' . psi, and (F)
+integrates to the
 rod's energy (E b W eps^2 / 2, EI kappa^2 / 2 with EI = E W b^3 / 12, GJ tau^2 / 2 with
 GJ = 2 D (1 - nu) W, E b W^3 kappa_g^2 / 24) plus this module's density
 
     f = E b [eps m . v + v . S v / 2] + (D / 2) [c . P c + 2 nu kappa p . c + nu^2 W kappa^2]
-        + D (1 - nu) c' . Q c',                                                                 (X)
+        + D (1 - nu) c' . Q c' + E b [kappa_g tau c' . a + tau^2 c' . Psi c' / 2],              (X)
 
     m_a = int phi_a (= 0 but for m_1 = W^3 / 24),  S_ab = int phi_a phi_b,  P_ij = int y^(2i + 2j - 4),
-    p_j = int y^(2j - 2),
+    p_j = int y^(2j - 2),  a_j = int y psi_j,  Psi_ij = int psi_i psi_j,
     Q_ij = int y^(2i + 2j - 2) / ((2i - 1)(2j - 1))   (integrals over the width),
 
-c' = dc/dx: the last term is the twisting energy of a cross-section whose shape changes along
-the strip (w_xy = sum_j c_j' y^(2j - 1) / (2j - 1)); it makes c a field with an adaptation length,
-about 0.41 W (1 - nu)^(1/2) where kappa = 0. The x-derivatives of w in the axial curvature (w_xx)
-are dropped: next to the c'^2 term they are of relative size W^2 / (60 l^2) at adaptation length l.
+c' = dc/dx. The last two terms are the energy of a cross-section whose shape changes along the
+strip (w_xy = sum_j c_j' y^(2j - 1) / (2j - 1)): its twisting, and the odd membrane strain that
+Gauss's -2 tau w_xy makes of it, about (W^2 tau / b)^2 / 56 times the twisting for one mode. They
+make c a field with an adaptation length, 0.41 W (1 - nu)^(1/2) where kappa = tau = 0, shorter
+under twist. Not kept: the terms quadratic in the x-derivatives of c in the membrane strain
+(w_xy^2 - w_xx w_yy of Eq. F) and in the bending (w_xx^2); the first-order term of w_xx in the
+bending, D kappa int w_xx, vanishes by the centroid convention.
 
 Its limits, all exact:
 - c = 0 (the cross-section kept straight): f = E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640, the
@@ -127,6 +137,11 @@ class CrossSectionModes:
         object.__setattr__(self, "p", p)
         object.__setattr__(self, "P", big_p)
         object.__setattr__(self, "Q", q)
+        # the odd strain of a changing cross-section, psi_j = 2 y^(2j + 1) / ((2j - 1) 2j (2j + 1))
+        d = (2 * j - 1) * 2.0 * j * (2 * j + 1)
+        object.__setattr__(self, "a", 2.0 * _width_integral(2 * j + 2, w) / d)
+        object.__setattr__(self, "Psi", 4.0 * _width_integral((2 * j + 1)[:, None] + (2 * j + 1)[None, :], w)
+                           / (d[:, None] * d[None, :]))
 
     @property
     def membrane(self) -> float:
@@ -184,36 +199,62 @@ def _point_density(eps, k, t, c, modes: CrossSectionModes):
     return value, first, second
 
 
-def field_density(eps, kappa, tau, c_before, c_after, voronoi_lengths, modes: CrossSectionModes):
-    """E_i per stencil (N,) and its partials (N, 3 + 2n) and second partials (N, 3 + 2n, 3 + 2n) in
-    the stencil's strains u = (eps_i, kappa_i, tau_i, c^{i-1}_1..n, c^i_1..n): kappa, tau the
-    rod's integrated strains (Eqs. 3-5), eps the Voronoi mean stretch, c_before/c_after (N, n) the
-    cross-section modes of the stencil's two edges."""
+def field_density(eps, kappa, kappa_g, tau, c_before, c_after, voronoi_lengths, modes: CrossSectionModes):
+    """E_i per stencil (N,) and its partials (N, 4 + 2n) and second partials (N, 4 + 2n, 4 + 2n) in
+    the stencil's strains u = (eps_i, kappa_i, kappa_g_i, tau_i, c^{i-1}_1..n, c^i_1..n): kappa,
+    kappa_g, tau the rod's integrated strains (Eqs. 3-5), eps the Voronoi mean stretch,
+    c_before/c_after (N, n) the cross-section modes of the stencil's two edges."""
     n = modes.modes
     ell = np.asarray(voronoi_lengths, dtype=float)
+    count = len(ell)
     c_mean = 0.5 * (c_before + c_after)
     f, f_z, f_zz = _point_density(eps, kappa / ell, tau / ell, c_mean, modes)
-    # u -> z: eps, kappa / l, tau / l, (c_before + c_after) / 2, a diagonal scaling then a copy
-    scale = np.empty((len(ell), 3 + n))
+    # u -> z = (eps, kappa / l, tau / l, (c_before + c_after) / 2): a diagonal scaling, then a copy
+    scale = np.empty((count, 3 + n))
     scale[:, 0] = ell
     scale[:, 1:3] = 1.0
     scale[:, 3:] = 0.5 * ell[:, None]
     z_of_u = np.r_[0, 1, 2, 3 + np.arange(n), 3 + np.arange(n)]
+    into = np.r_[0, 1, 3, 4 + np.arange(2 * n)]  # u without kappa_g, within u
+    size = 4 + 2 * n
     energy = ell * f
-    first = (scale * f_z)[:, z_of_u]
-    second = (f_zz * (scale[:, :, None] * scale[:, None, :] / ell[:, None, None]))[:, z_of_u][:, :, z_of_u]
-    # the cross-section's change along the strip: D (1 - nu) dc . Q dc / l
+    first = np.zeros((count, size))
+    second = np.zeros((count, size, size))
+    first[:, into] = (scale * f_z)[:, z_of_u]
+    second[:, into[:, None], into[None, :]] = (f_zz * (scale[:, :, None] * scale[:, None, :]
+                                                       / ell[:, None, None]))[:, z_of_u][:, :, z_of_u]
+    # terms of dc = c^i - c^{i-1}: the twisting of a changing cross-section, D (1 - nu) dc . Q dc / l,
+    # and the odd strain -tau c' . psi(y): E b [kappa_g tau dc . a / l^2 + tau^2 dc . Psi dc / (2 l^3)]
     g = modes.plate * (1.0 - modes.poisson_ratio)
+    eb = modes.membrane
     dc = c_after - c_before
-    qdc = dc @ modes.Q
-    energy += g * np.einsum("nj,nj->n", dc, qdc) / ell
-    first[:, 3:3 + n] -= 2.0 * g * qdc / ell[:, None]
-    first[:, 3 + n:] += 2.0 * g * qdc / ell[:, None]
-    block = 2.0 * g * modes.Q[None, :, :] / ell[:, None, None]
-    second[:, 3:3 + n, 3:3 + n] += block
-    second[:, 3 + n:, 3 + n:] += block
-    second[:, 3:3 + n, 3 + n:] -= block
-    second[:, 3 + n:, 3:3 + n] -= block
+    qdc, adc, pdc = dc @ modes.Q, dc @ modes.a, dc @ modes.Psi
+    dpd = np.einsum("nj,nj->n", dc, pdc)
+    kg, t = kappa_g, tau
+    l2, l3 = ell**2, ell**3
+    energy += g * np.einsum("nj,nj->n", dc, qdc) / ell + eb * (kg * t * adc / l2 + 0.5 * t * t * dpd / l3)
+    d_dc = (2.0 * g * qdc / ell[:, None] + eb * ((kg * t / l2)[:, None] * modes.a[None, :]
+                                                 + (t * t / l3)[:, None] * pdc))
+    before, after = slice(4, 4 + n), slice(4 + n, 4 + 2 * n)
+    first[:, before] -= d_dc
+    first[:, after] += d_dc
+    first[:, 2] += eb * t * adc / l2
+    first[:, 3] += eb * (kg * adc / l2 + t * dpd / l3)
+    second[:, 2, 3] += eb * adc / l2
+    second[:, 3, 2] += eb * adc / l2
+    second[:, 3, 3] += eb * dpd / l3
+    g_dc = eb * (t / l2)[:, None] * modes.a[None, :]                      # d2 / dkappa_g d(dc)
+    t_dc = eb * ((kg / l2)[:, None] * modes.a[None, :] + 2.0 * (t / l3)[:, None] * pdc)  # d2 / dtau d(dc)
+    for block, sign in ((before, -1.0), (after, 1.0)):
+        second[:, 2, block] += sign * g_dc
+        second[:, block, 2] += sign * g_dc
+        second[:, 3, block] += sign * t_dc
+        second[:, block, 3] += sign * t_dc
+    dcdc = 2.0 * g * modes.Q[None, :, :] / ell[:, None, None] + eb * (t * t / l3)[:, None, None] * modes.Psi[None]
+    second[:, before, before] += dcdc
+    second[:, after, after] += dcdc
+    second[:, before, after] -= dcdc
+    second[:, after, before] -= dcdc
     return energy, first, second
 
 

@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from ..energies.cross_section import CrossSectionModes, field_density
+from ..energies.rod_curvature import material_curvatures
 from ..energies.sadowsky import check_zeta
 from ..energies.stencil_coupling import (add_local_terms, add_placed_terms, pair_blocks, stencil_strain_blocks,
                                          stencil_stretch)
@@ -114,11 +115,13 @@ class CrossSectionRibbon(RodModel):
     def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
         c = q[self.field_dofs]
         eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
-        energy, first, second = field_density(eps, kappa_n, tau, c[:-1], c[1:], self.voronoi_lengths, self.modes)
+        _, kappa_g = material_curvatures(x, m1, m2)
+        energy, first, second = field_density(eps, kappa_n, kappa_g, tau, c[:-1], c[1:], self.voronoi_lengths,
+                                              self.modes)
         if gradient:
             grads, hessians = stencil_strain_blocks(x, m1, m2)
-            strain_grads = np.concatenate([eps_grad[:, None], grads[:, [_KAPPA_N, _TAU]]], axis=1)
-            strain_hess = np.concatenate([eps_hess[:, None], hessians[:, [_KAPPA_N, _TAU]]], axis=1)
+            strain_grads = np.concatenate([eps_grad[:, None], grads], axis=1)
+            strain_hess = np.concatenate([eps_hess[:, None], hessians], axis=1)
             add_placed_terms(self.node_stride * np.arange(len(eps)), self._rod_place, strain_grads, strain_hess,
                              self._mode_place, first, second, self.n_dof, grad, band, hessian)
         return {"cross_section": float(energy.sum())}
@@ -196,7 +199,6 @@ class WunderlichRibbon(RibbonModel):
         out = super().resolution_indicators(q)
         x = q[self.node_dofs]
         t, _, m1, m2, m_ref = self.frames(q)
-        from ..energies.rod_curvature import material_curvatures
         from ..energies.rod_twist import discrete_twist
 
         kappa_n, _ = material_curvatures(x, m1, m2)

@@ -102,15 +102,16 @@ def test_markdown_table_has_ten_scene_rows_and_dashes_for_missing_values(tmp_pat
     lines = table_lines(markdown_table(rows))
     assert len(lines) == 2 + 10 and set(lines[1]) <= set("|-: ")
     header = [c.strip() for c in lines[0].strip().strip("|").split(" | ")]
-    assert len(header) == 17 and header[6] == "mid-edge dW1/L" and header[11] == "mid-edge dW2/L"
+    assert len(header) == 19 and header[6] == "mid-edge dW1/L" and header[11] == "mid-edge dW2/L"
+    assert header[17:] == ["cross-section dW1/L", "cross-section dW2/L"]
     cells = [[c.strip() for c in line.strip().strip("|").split(" | ")] for line in lines[2:]]
-    assert all(len(c) == 17 for c in cells)
+    assert all(len(c) == 19 for c in cells)
     first = cells[0]
     assert first[:3] == ["1/2", "1/20", "3.0"]
     assert first[3] == "0.3500 ± 0.0040" and first[4] == "0.3450 ± 0.0002"
     assert first[5] == f"{0.005 / 0.0042:.1f}"
     assert first[6:8] == first[4:6]  # fake_load gives the mid-edge plate the plate's studies
-    assert first[13:] == ["0.3600", "0.5200", "0.3610 ± 0.0010", "0.5200"]
+    assert first[13:] == ["0.3600", "0.5200", "0.3610 ± 0.0010", "0.5200", "–", "–"]
     no_fem = cells[5]   # dL/L = 1/4, W/L = 1/20
     assert no_fem[:2] == ["1/4", "1/20"]
     assert no_fem[3] == "–" and no_fem[5] == "–" and no_fem[4] == "0.2100 ± 0.0004" and no_fem[13] == "0.2300"

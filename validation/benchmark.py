@@ -12,7 +12,9 @@ with the spread); the plate-FEM comparison is validation.claims.threshold_agreem
 difference in units of the combined error bar, the sum of the two). The rod's values come from its
 own study on M = 50/100/200 elements (three runs of ddg.simulate per scene, a few seconds), stored in
 OUT/rod_thresholds.json after each scene and not rerun when present there (resumable; --no-rod
-computes none and uses the stored ones where the file exists). Writes OUT/benchmark.csv (every
+computes none and uses the stored ones where the file exists); likewise the 1D model with its
+cross-section (ribbon-cross-section, issue 30) on M = 51/101/201 nodes, in
+OUT/cross_section_thresholds.json. Writes OUT/benchmark.csv (every
 column, with the meshes of each study) and OUT/benchmark.md (the table and its legend), and prints
 the table. Regenerate after a new mesh study: `.venv/bin/python -m validation.benchmark --out
 data/benchmark`.
@@ -37,6 +39,9 @@ from .studies import COMPRESSIONS, WIDTHS_GOLD
 ROD_RESOLUTIONS = (50, 100, 200)
 THRESHOLDS = ("dW1", "dW2")
 ROD_FILE = "rod_thresholds.json"
+CROSS_SECTION_FILE = "cross_section_thresholds.json"
+#: The 1D models with a study per scene: their file in OUT and their resolutions.
+ONE_D_STUDIES = {"rod": (ROD_FILE, ROD_RESOLUTIONS), "ribbon-cross-section": (CROSS_SECTION_FILE, (51, 101, 201))}
 MISSING = "\u2013"   # en dash: no data
 
 LEGEND = (
@@ -53,7 +58,8 @@ LEGEND = (
     "combined error bar, the sum of the two error bars (validation.claims.threshold_agreement). Paper: the "
     "values quoted in the text of Huang, Wang, Li, Jawed (at dL/L = 1/4 and W/L > 1/20, 0.23 times the "
     "quoted percent drop). Rod: the converged value of the rod's study on M = 50/100/200 elements, the "
-    "same estimate. \u2013: no data (no study, or no value or error bar in it). The meshes each value rests "
+    "same estimate; cross-section: that of the 1D model with its cross-section (ribbon-cross-section) on "
+    "M = 51/101/201 nodes. \u2013: no data (no study, or no value or error bar in it). The meshes each value rests "
     "on, the signed differences and the basis of every error bar are listed per row in benchmark.csv."
 )
 
@@ -94,11 +100,13 @@ def _safe_load(load, model: str, compression_ratio: float, width_ratio: float) -
         return None
 
 
-def benchmark_rows(rod_thresholds: dict | None = None, load=None) -> list[dict]:
+def benchmark_rows(rod_thresholds: dict | None = None, load=None, cross_section_thresholds: dict | None = None
+                   ) -> list[dict]:
     """One row per scene (benchmark_scenes() order) of the benchmark: W^2/(bL), then for dW1 and dW2 the FEM
     and plate converged values with error bar, basis and meshes, the signed difference plate - FEM,
     |difference| / combined error bar, the paper's value and the rod's value with error bar.
-    `rod_thresholds`: the output of rod_thresholds() ({scene name: {...}}), or None; `load(model,
+    `rod_thresholds`, `cross_section_thresholds`: the output of rod_thresholds() for "rod" and
+    "ribbon-cross-section" ({scene name: {...}}), or None; `load(model,
     dL/L, W/L)` gives a Study or None (default validation.estimates.load_study). Missing data is None."""
     import ddg
 
@@ -110,6 +118,7 @@ def benchmark_rows(rod_thresholds: dict | None = None, load=None) -> list[dict]:
         plate = _safe_load(load, "plate", compression, width)
         midedge = _safe_load(load, "plate-midedge", compression, width)
         rod = (rod_thresholds or {}).get(gold_name(compression, width)) or {}
+        cross = (cross_section_thresholds or {}).get(gold_name(compression, width)) or {}
         row = {"compression_ratio": compression, "width_ratio": width,
                "width_squared_over_thickness_length": width**2 * strip.slenderness}
         for key in THRESHOLDS:
@@ -129,48 +138,52 @@ def benchmark_rows(rod_thresholds: dict | None = None, load=None) -> list[dict]:
             row[f"paper_{key}"] = paper_value(compression, width, key)
             row[f"rod_{key}"] = rod.get(key)
             row[f"rod_{key}_error_bar"] = rod.get(f"{key}_error_bar")
+            row[f"cross_section_{key}"] = cross.get(key)
+            row[f"cross_section_{key}_error_bar"] = cross.get(f"{key}_error_bar")
         rows.append(row)
     return rows
 
 
-def rod_study(compression_ratio: float, width_ratio: float, resolutions=ROD_RESOLUTIONS) -> Study | None:
-    """The rod's study of one scene: ddg.simulate at each resolution (no branch tracing), the
-    runs read as a study by validation.estimates.study_from_runs."""
+def rod_study(compression_ratio: float, width_ratio: float, resolutions=ROD_RESOLUTIONS,
+              model: str = "rod") -> Study | None:
+    """A 1D model's study of one scene (the rod by default): ddg.simulate at each resolution (no
+    branch tracing), the runs read as a study by validation.estimates.study_from_runs."""
     import ddg
 
     strip = ddg.Strip.from_ratios(width_ratio, compression_ratio)
-    runs = [ddg.simulate(strip, ddg.LoadingProtocol(compression_ratio), model="rod", resolution=m, branches=False)
+    runs = [ddg.simulate(strip, ddg.LoadingProtocol(compression_ratio), model=model, resolution=m, branches=False)
             for m in resolutions]
-    return study_from_runs("rod", runs, list(resolutions))
+    return study_from_runs(model, runs, list(resolutions))
 
 
-def rod_thresholds(out: Path, scenes=None, quiet: bool = True) -> dict:
-    """The rod's converged thresholds per scene, {scene name: {"dW1", "dW1_error_bar", "dW2",
-    "dW2_error_bar", "wall_time_s", "resolutions", "converged"}} (values None where the study has
-    none), for `scenes` ((dL/L, W/L) pairs, default all ten). Stored in OUT/rod_thresholds.json
-    (atomically) after each scene; a scene already in the file is not rerun."""
+def rod_thresholds(out: Path, scenes=None, quiet: bool = True, model: str = "rod") -> dict:
+    """A 1D model's converged thresholds per scene (the rod by default; ONE_D_STUDIES), {scene name:
+    {"dW1", "dW1_error_bar", "dW2", "dW2_error_bar", "wall_time_s", "resolutions", "converged"}}
+    (values None where the study has none), for `scenes` ((dL/L, W/L) pairs, default all ten).
+    Stored in OUT/<its file> (atomically) after each scene; a scene already in the file is not rerun."""
     out = Path(out)
-    path = out / ROD_FILE
+    filename, resolutions = ONE_D_STUDIES[model]
+    path = out / filename
     stored = read_json_object(path) or {}
     for compression, width in scenes if scenes is not None else benchmark_scenes():
         name = gold_name(compression, width)
         if name in stored:
             continue
         t0 = time.perf_counter()
-        study = rod_study(compression, width)
+        study = rod_study(compression, width, resolutions, model)
         entry = {}
         for key in THRESHOLDS:
             estimate = study.threshold(key) if study is not None else None
             entry[key] = None if estimate is None else estimate.value
             entry[f"{key}_error_bar"] = None if estimate is None else estimate.error_bar
         entry["wall_time_s"] = time.perf_counter() - t0
-        entry["resolutions"] = list(ROD_RESOLUTIONS)
+        entry["resolutions"] = list(resolutions)
         entry["converged"] = bool(study is not None and all(r.summary.get("converged") for r in study.runs))
         stored[name] = entry
         out.mkdir(parents=True, exist_ok=True)
         atomic_write_text(path, json.dumps(stored, indent=2) + "\n")
         if not quiet:
-            print(f"rod {name}: dW1/L {entry['dW1']}, dW2/L {entry['dW2']}, {entry['wall_time_s']:.0f} s",
+            print(f"{model} {name}: dW1/L {entry['dW1']}, dW2/L {entry['dW2']}, {entry['wall_time_s']:.0f} s",
                   file=sys.stderr, flush=True)
     return stored
 
@@ -195,8 +208,9 @@ def markdown_table(rows: list[dict]) -> str:
     """The benchmark as a markdown table (no legend), one line per row of benchmark_rows()."""
     lines = ["| dL/L | W/L | W\u00b2/(bL) | FEM dW1/L | plate dW1/L | \\|diff\\|/combined | mid-edge dW1/L | "
              "\\|diff\\|/combined | FEM dW2/L | plate dW2/L | \\|diff\\|/combined | mid-edge dW2/L | "
-             "\\|diff\\|/combined | paper dW1/L | paper dW2/L | rod dW1/L | rod dW2/L |",
-             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+             "\\|diff\\|/combined | paper dW1/L | paper dW2/L | rod dW1/L | rod dW2/L | cross-section dW1/L | "
+             "cross-section dW2/L |",
+             "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
         cells = [fraction_label(r["compression_ratio"]), fraction_label(r["width_ratio"]),
                  _number(r["width_squared_over_thickness_length"], "{:.1f}")]
@@ -207,7 +221,9 @@ def markdown_table(rows: list[dict]) -> str:
                       _with_bar(r[f"midedge_{key}"], r[f"midedge_{key}_error_bar"]),
                       _number(r[f"midedge_{key}_in_error_bars"], "{:.1f}")]
         cells += [_number(r["paper_dW1"]), _number(r["paper_dW2"]),
-                  _with_bar(r["rod_dW1"], r["rod_dW1_error_bar"]), _with_bar(r["rod_dW2"], r["rod_dW2_error_bar"])]
+                  _with_bar(r["rod_dW1"], r["rod_dW1_error_bar"]), _with_bar(r["rod_dW2"], r["rod_dW2_error_bar"]),
+                  _with_bar(r["cross_section_dW1"], r["cross_section_dW1_error_bar"]),
+                  _with_bar(r["cross_section_dW2"], r["cross_section_dW2_error_bar"])]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -237,7 +253,8 @@ def write_benchmark(out: Path, rows: list[dict]) -> None:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     write_table_csv(out / "benchmark.csv", rows)
-    text = ("# Thresholds of the ten benchmark scenes: FEM shell, DDG plate, paper, rod (validation/benchmark.py)\n\n"
+    text = ("# Thresholds of the ten benchmark scenes: FEM shell, DDG plate, paper, rod, cross-section "
+            "(validation/benchmark.py)\n\n"
             + markdown_table(rows) + "\n" + basis_sentence(rows) + "\n\n" + LEGEND + "\n")
     atomic_write_text(out / "benchmark.md", text)
 
@@ -250,7 +267,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m validation.benchmark", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/benchmark", help="output directory (default data/benchmark)")
     parser.add_argument("--no-rod", action="store_true",
-                        help="run no rod; use OUT/rod_thresholds.json where it exists")
+                        help="run no 1D model (rod, ribbon-cross-section); use their stored files in OUT where they exist")
     args = parser.parse_args(argv)
     try:
         out = check_output_directory(args.out, "--out")
@@ -258,10 +275,11 @@ def main(argv=None) -> int:
         print(f"error: {exc}")
         return 2
     if args.no_rod:
-        rods = read_json_object(out / ROD_FILE)
+        rods, crosses = read_json_object(out / ROD_FILE), read_json_object(out / CROSS_SECTION_FILE)
     else:
         rods = rod_thresholds(out, quiet=False)
-    rows = benchmark_rows(rods)
+        crosses = rod_thresholds(out, quiet=False, model="ribbon-cross-section")
+    rows = benchmark_rows(rods, cross_section_thresholds=crosses or None)
     write_benchmark(out, rows)
     print(markdown_table(rows), end="")
     return 0

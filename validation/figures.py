@@ -14,7 +14,8 @@ import numpy as np
 from .report_data import FigureData, fraction
 
 COLORS = {"rod": "tab:blue", "plate": "tab:orange", "plate-midedge": "tab:red", "ribbon": "tab:green", "fem": "black",
-          "ribbon-sano-wada": "tab:olive", "ribbon-trapeze": "tab:purple", "ribbon-wunderlich": "tab:brown",
+          "ribbon-sano-wada": "tab:olive", "ribbon-trapeze": "tab:purple", "ribbon-cross-section": "tab:pink",
+          "ribbon-wunderlich": "tab:brown",
           "fem (extrapolated)": "black", "fem (converged)": "black", "plate (converged)": "tab:orange"}
 STABILITY_CATEGORIES = ["ok", "ok (mesh unresolved near dW_max)", "missed pitchfork", "dW1 unresolved by the mesh",
                         "rod width error", "Newton failure"]
@@ -49,7 +50,7 @@ def pareto(points: list[tuple[float, float]]) -> list[int]:
 
 # ---------------------------------------------------------------------------- one function per kind
 MARKERS = {"rod": "o", "plate": "s", "plate-midedge": "h", "ribbon": "^", "fem": "D", "ribbon-sano-wada": "v",
-           "ribbon-trapeze": "P", "ribbon-wunderlich": "X"}
+           "ribbon-trapeze": "P", "ribbon-cross-section": "*", "ribbon-wunderlich": "X"}
 
 
 def elastica(rows: list[dict], exact: list[tuple[float, float]]):

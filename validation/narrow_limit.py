@@ -9,8 +9,9 @@ the gap is physics.
 
 `python -m validation.narrow_limit [--out data/narrow_limit] [--slenderness 1181.10236 300 100]`
 runs, at each L/b, the FEM shell (fem_reference simulate, 64 x 8 and 96 x 12 elements), the DDG
-plate (exactly equilateral meshes of 8 and 12 rows) and the rod (M = 100, 200; it depends on L/b
-through its in-plane bending stiffness only, (W/b)^2 times its out-of-plane one) through the
+plate (exactly equilateral meshes of 8 and 12 rows), the rod (M = 100, 200; it depends on L/b
+through its in-plane bending stiffness only, (W/b)^2 times its out-of-plane one) and the 1D model
+with its cross-section (ribbon-cross-section, M = 101, 201; issue 30) through the
 README's path (40 compression and 120 shear steps to dW_max, no branch tracing) into
 OUT/Lb<L/b>/<model>_<mesh>/ (path.csv, summary.json; at the paper's L/b the FEM and plate runs are
 those of data/fem_gold and data/plate_gold), then writes OUT/narrow_limit.json and
@@ -34,6 +35,7 @@ PAPER_SLENDERNESS = 1181.1023622047244
 FEM_MESHES = ((64, 8), (96, 12))
 PLATE_ROWS = (8, 12)
 ROD_RESOLUTIONS = (100, 200)
+CROSS_SECTION_RESOLUTIONS = (101, 201)
 
 
 def run_fem(folder: Path, slenderness: float, along: int, across: int) -> dict | None:
@@ -49,7 +51,7 @@ def run_fem(folder: Path, slenderness: float, along: int, across: int) -> dict |
 
 
 def run_ddg(folder: Path, model: str, slenderness: float, resolution: int) -> dict | None:
-    """One DDG run (plate: an equilateral mesh of `resolution` rows; rod: M = resolution)."""
+    """One DDG run (plate: an equilateral mesh of `resolution` rows; the 1D models: M = resolution)."""
     if (done := finished_run_summary(folder)) is not None:
         return done
     import ddg
@@ -62,7 +64,7 @@ def run_ddg(folder: Path, model: str, slenderness: float, resolution: int) -> di
         ddg.simulate(strip, protocol, model="plate", mesh=mesh, out=folder, branches=False, progress=False,
                      centerline=False)
     else:
-        ddg.simulate(strip, protocol, model="rod", resolution=resolution, out=folder, branches=False, progress=False,
+        ddg.simulate(strip, protocol, model=model, resolution=resolution, out=folder, branches=False, progress=False,
                      centerline=False)
     return finished_run_summary(folder)
 
@@ -72,6 +74,7 @@ def runs(slenderness: float) -> list[tuple[str, str, int, int | None]]:
     out = [("fem", f"fem_N{a}x{c}", a, c) for a, c in FEM_MESHES]
     out += [("plate", f"plate_R{r}", r, None) for r in PLATE_ROWS]
     out += [("rod", f"rod_M{m}", m, None) for m in ROD_RESOLUTIONS]
+    out += [("ribbon-cross-section", f"ribbon-cross-section_M{m}", m, None) for m in CROSS_SECTION_RESOLUTIONS]
     return out
 
 

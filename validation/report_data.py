@@ -660,9 +660,11 @@ def benchmark_table() -> Table:
     """The benchmark (validation.benchmark): converged thresholds of the ten scenes from the stored
     FEM and plate studies, with the rod's stored study (data/benchmark/rod_thresholds.json) where
     it exists."""
-    from .benchmark import ROD_FILE, benchmark_rows
+    from .benchmark import CROSS_SECTION_FILE, ROD_FILE, benchmark_rows
 
-    rows = benchmark_rows(rod_thresholds=read_json_object(ROOT / "data" / "benchmark" / ROD_FILE) or None)
+    stored = ROOT / "data" / "benchmark"
+    rows = benchmark_rows(rod_thresholds=read_json_object(stored / ROD_FILE) or None,
+                          cross_section_thresholds=read_json_object(stored / CROSS_SECTION_FILE) or None)
     columns = list(rows[0].keys()) if rows else []
     shown = [c for c in columns if not c.endswith(("_basis", "_meshes"))]
     return Table("benchmark", columns, rows, csv=True, shown=shown)
@@ -671,7 +673,7 @@ def benchmark_table() -> Table:
 #: The 1D models of the "1D models with width" section and the resolution shown for each (the
 #: ribbons' default M = 101, the rod's paper M = 100); the plate at its study's finest mesh.
 WIDE_MODELS = (("rod", "M100"), ("ribbon", "M101"), ("ribbon-sano-wada", "M101"), ("ribbon-trapeze", "M101"),
-               ("ribbon-wunderlich", "M101"))
+               ("ribbon-cross-section", "M101"), ("ribbon-wunderlich", "M101"))
 #: Tolerance (units of L) of the "cheapest model within" table: the issue's 1 %.
 ENOUGH_TOLERANCE = 0.01
 WIDE_COLUMNS = ["compression_ratio", "width_ratio", "model", "resolution", "dW1_over_L", "dW2_over_L",

@@ -1,0 +1,109 @@
+"""Issue 30's targets for the 1D model with its cross-section (ribbon-cross-section), measured
+against the converged FEM studies on the committed data: the error map's rows (data/error_map,
+`python -m validation.error_map --models ribbon-cross-section`, M = 51/101/201 on every map scene)
+and the speed benchmark (benchmarks/results/cross_section_path.json).
+
+The bounds are the issue's, fixed before these data existed: dW1/L and dW2/L within 0.005 of the
+FEM and H_mid/L within 0.01 away from the thresholds at dL/L = 1/2 and 1/4, W/L = 1/20 and 1/12;
+within 0.01 at W/L = 1/6; within 0.005 at W/L = 1/20, L/b = 300 and 4000 where the FEM has the
+value; the M = 101 and 201 thresholds within 1e-3 of each other; the wall time at most 2x the
+rod's at the same M. Each case is one (scene, quantity); a case not met is a strict expected
+failure whose reason carries the measured figure (M = 201 unless said), so a change that meets it
+shows up as an unexpected pass.
+"""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from validation.error_map import ROOT, read_table
+
+MODEL = "ribbon-cross-section"
+MAP = ROOT / "data" / "error_map" / "error_map.csv"
+SPEED = ROOT / "benchmarks" / "results" / "cross_section_path.json"
+NARROW = ("dL0.5_W0.05_Lb1181", "dL0.5_W0.08333_Lb1181", "dL0.25_W0.05_Lb787", "dL0.25_W0.08333_Lb787")
+
+
+def _row(scene: str, label: str = "M201") -> dict:
+    rows = [r for r in read_table(MAP) if r["model"] == MODEL and r["scene"] == scene and r["resolution_label"] == label]
+    assert len(rows) == 1, (scene, label)
+    return rows[0]
+
+
+def _value(row: dict, column: str) -> float | None:
+    return float(row[column]) if row[column] not in ("", None) else None
+
+
+def _unmet(reason: str):
+    return pytest.mark.xfail(strict=True, reason=reason)
+
+
+#: (scene, quantity, bound, measured figures when not met)
+ACCURACY_CASES = [
+    ("dL0.5_W0.05_Lb1181", "dW1", 0.005, "dW1 0.3645 against 0.3511: error 0.0134"),
+    ("dL0.5_W0.05_Lb1181", "dW2", 0.005, None),
+    ("dL0.5_W0.05_Lb1181", "H_mid", 0.01, "H_mid error 0.0211 (the shifted dW1 moves the path)"),
+    ("dL0.5_W0.08333_Lb1181", "dW1", 0.005, "dW1 0.2881 against 0.3275: error 0.0394 (M = 51, 101: none)"),
+    ("dL0.5_W0.08333_Lb1181", "dW2", 0.005, "no dW2: the path stops at a fold of US at dW/L 0.506"),
+    ("dL0.5_W0.08333_Lb1181", "H_mid", 0.01, "H_mid error 0.262"),
+    ("dL0.25_W0.05_Lb787", "dW1", 0.005, "dW1 0.2274 against 0.2187: error 0.0087"),
+    ("dL0.25_W0.05_Lb787", "dW2", 0.005, None),
+    ("dL0.25_W0.05_Lb787", "H_mid", 0.01, "H_mid error 0.0112"),
+    ("dL0.25_W0.08333_Lb787", "dW1", 0.005, "dW1 0.2172 against 0.2084: error 0.0088"),
+    ("dL0.25_W0.08333_Lb787", "dW2", 0.005, "no dW2 at M = 201 (the path stops; M = 101: error 0.0015)"),
+    ("dL0.25_W0.08333_Lb787", "H_mid", 0.01, "H_mid error 0.0135"),
+    ("dL0.5_W0.1667_Lb1181", "dW1", 0.01, "dW1 0.1660 against 0.2654: error 0.0994"),
+    ("dL0.5_W0.1667_Lb1181", "dW2", 0.01, "no dW2 (the shell's 0.4308)"),
+    ("dL0.25_W0.1667_Lb787", "dW1", 0.01, "no dW1 at M = 201 (M = 51: 0.1186 against 0.1610)"),
+    ("dL0.25_W0.1667_Lb787", "dW2", 0.01, "no dW2 (the shell's 0.2594)"),
+    ("dL0.5_W0.05_Lb300", "dW1", 0.005, "dW1 0.3610 against 0.3393: error 0.0217 (the rod's 0.3571)"),
+    ("dL0.5_W0.05_Lb300", "dW2", 0.005, None),
+    ("dL0.5_W0.05_Lb4000", "dW1", 0.005, "no dW1: the path stops on U (the shell's 0.3466 +- 0.0573)"),
+]
+
+
+@pytest.mark.parametrize("scene, quantity, bound", [
+    pytest.param(scene, quantity, bound, marks=() if figures is None else _unmet(figures), id=f"{scene}-{quantity}")
+    for scene, quantity, bound, figures in ACCURACY_CASES])
+def test_cross_section_model_is_within_the_issues_bound_of_the_converged_fem(scene, quantity, bound):
+    """|model - FEM| (the error map's error column, M = 201) within the issue's bound; a missing
+    value (no threshold found, or H_mid compared nowhere) is not met."""
+    error = _value(_row(scene), f"{quantity}_error")
+    assert error is not None and error <= bound, error
+
+
+#: (scene, quantity, measured |M101 - M201|) of the narrow target scenes.
+CONVERGENCE_CASES = [
+    ("dL0.5_W0.05_Lb1181", "dW1", "0.3592 / 0.3645: 0.0053"),
+    ("dL0.5_W0.05_Lb1181", "dW2", None),
+    ("dL0.25_W0.05_Lb787", "dW1", "0.2262 / 0.2274: 0.0012"),
+    ("dL0.25_W0.05_Lb787", "dW2", "0.3341 / 0.3354: 0.0013"),
+    ("dL0.25_W0.08333_Lb787", "dW1", "0.2189 / 0.2172: 0.0017"),
+    ("dL0.25_W0.08333_Lb787", "dW2", "M = 201 has none (M = 101: 0.3014)"),
+    ("dL0.5_W0.08333_Lb1181", "dW1", "M = 101 has none (M = 201: 0.2881)"),
+]
+
+
+@pytest.mark.parametrize("scene, quantity", [
+    pytest.param(scene, quantity, marks=() if figures is None else _unmet(figures), id=f"{scene}-{quantity}")
+    for scene, quantity, figures in CONVERGENCE_CASES])
+def test_thresholds_at_101_and_201_nodes_agree_to_1e_3(scene, quantity):
+    coarse, fine = _value(_row(scene, "M101"), quantity), _value(_row(scene, "M201"), quantity)
+    assert coarse is not None and fine is not None and abs(coarse - fine) <= 1e-3, (coarse, fine)
+
+
+def test_map_has_the_models_rows_on_every_scene_at_three_resolutions():
+    rows = [r for r in read_table(MAP) if r["model"] == MODEL]
+    scenes = {r["scene"] for r in read_table(MAP)}
+    assert {(r["scene"], r["resolution_label"]) for r in rows} == {(s, m) for s in scenes for m in ("M51", "M101", "M201")}
+
+
+@pytest.mark.xfail(strict=True, reason="wall time 2.0x to 27.8x the rod's at the same M on the four narrow scenes "
+                                       "(benchmarks/results/cross_section_path.md): 2585-8267 Newton iterations "
+                                       "against the rod's 857-1401, every cross-section path stopping at a fold; the "
+                                       "target is 2x")
+def test_wall_time_is_at_most_twice_the_rods():
+    report = json.loads(SPEED.read_text())
+    ratios = [r["wall_time_ratio"] for r in report["rows"]]
+    assert len(ratios) == 8 and max(ratios) <= 2.0, ratios

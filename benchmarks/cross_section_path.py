@@ -57,7 +57,8 @@ def measure(nodes_list, repeat: int) -> list[dict]:
 
 
 def markdown(report: dict) -> str:
-    lines = ["# ribbon-cross-section against the rod: wall time at the same M (benchmarks/cross_section_path.py)", "",
+    lines = ["# ribbon-cross-section against the rod: wall time at the same M "
+             "(benchmarks/cross_section_path.py)", "",
              "| dL/L | W/L | M | rod s | rod its | cross-section s | cross-section its | cross-section status | ratio |",
              "|---:|---:|---:|---:|---:|---:|---:|---|---:|"]
     for r in report["rows"]:
@@ -73,7 +74,8 @@ def markdown(report: dict) -> str:
 def main(argv=None) -> int:
     from ddg.output.io import atomic_write_text
 
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.cross_section_path", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.cross_section_path",
+                                     description=__doc__.split("\n")[0])
     parser.add_argument("--nodes", type=int, nargs="+", default=[101, 201])
     parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--out", default="benchmarks/results")

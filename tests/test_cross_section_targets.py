@@ -26,7 +26,8 @@ NARROW = ("dL0.5_W0.05_Lb1181", "dL0.5_W0.08333_Lb1181", "dL0.25_W0.05_Lb787", "
 
 
 def _row(scene: str, label: str = "M201") -> dict:
-    rows = [r for r in read_table(MAP) if r["model"] == MODEL and r["scene"] == scene and r["resolution_label"] == label]
+    rows = [r for r in read_table(MAP)
+            if r["model"] == MODEL and r["scene"] == scene and r["resolution_label"] == label]
     assert len(rows) == 1, (scene, label)
     return rows[0]
 
@@ -96,7 +97,8 @@ def test_thresholds_at_101_and_201_nodes_agree_to_1e_3(scene, quantity):
 def test_map_has_the_models_rows_on_every_scene_at_three_resolutions():
     rows = [r for r in read_table(MAP) if r["model"] == MODEL]
     scenes = {r["scene"] for r in read_table(MAP)}
-    assert {(r["scene"], r["resolution_label"]) for r in rows} == {(s, m) for s in scenes for m in ("M51", "M101", "M201")}
+    expected = {(s, m) for s in scenes for m in ("M51", "M101", "M201")}
+    assert {(r["scene"], r["resolution_label"]) for r in rows} == expected
 
 
 @pytest.mark.xfail(strict=True, reason="wall time 2.0x to 27.8x the rod's at the same M on the four narrow scenes "

@@ -267,7 +267,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m validation.benchmark", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/benchmark", help="output directory (default data/benchmark)")
     parser.add_argument("--no-rod", action="store_true",
-                        help="run no 1D model (rod, ribbon-cross-section); use their stored files in OUT where they exist")
+                        help="run no 1D model (rod, ribbon-cross-section); use their stored files in OUT where "
+                             "they exist")
     args = parser.parse_args(argv)
     try:
         out = check_output_directory(args.out, "--out")

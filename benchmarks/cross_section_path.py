@@ -59,7 +59,8 @@ def measure(nodes_list, repeat: int) -> list[dict]:
 def markdown(report: dict) -> str:
     lines = ["# ribbon-cross-section against the rod: wall time at the same M "
              "(benchmarks/cross_section_path.py)", "",
-             "| dL/L | W/L | M | rod s | rod its | cross-section s | cross-section its | cross-section status | ratio |",
+             "| dL/L | W/L | M | rod s | rod its | cross-section s | cross-section its | cross-section status "
+             "| ratio |",
              "|---:|---:|---:|---:|---:|---:|---:|---|---:|"]
     for r in report["rows"]:
         lines.append(f"| {r['compression_ratio']:g} | {r['width_ratio']:.4g} | {r['nodes']} | "
@@ -82,7 +83,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     bad = [m for m in args.nodes if not 11 <= m <= 2001]
     if bad or not 1 <= args.repeat <= 10:
-        parser.exit(2, f"--nodes {bad[0] if bad else ''} outside [11, 2001] or --repeat {args.repeat} outside [1, 10]\n")
+        parser.exit(2, f"--nodes {bad[0] if bad else ''} outside [11, 2001] or --repeat {args.repeat} "
+                       "outside [1, 10]\n")
     load_before = os.getloadavg()[0]
     rows = measure(args.nodes, args.repeat)
     report = {"rows": rows, "repeat": args.repeat, "load_average": [load_before, os.getloadavg()[0]],

@@ -7,11 +7,13 @@ from validation import narrow_limit as N
 
 
 def test_every_model_runs_at_every_slenderness():
-    """The rod too: its in-plane bending stiffness is (W/b)^2 times its out-of-plane one."""
+    """The rod too: its in-plane bending stiffness is (W/b)^2 times its out-of-plane one; and the 1D
+    model with its cross-section (issue 30)."""
     for s in (N.PAPER_SLENDERNESS, 300.0):
         runs = N.runs(s)
-        assert {m for m, *_ in runs} == {"fem", "plate", "rod"}
-        assert len(runs) == len(N.FEM_MESHES) + len(N.PLATE_ROWS) + len(N.ROD_RESOLUTIONS)
+        assert {m for m, *_ in runs} == {"fem", "plate", "rod", "ribbon-cross-section"}
+        assert len(runs) == (len(N.FEM_MESHES) + len(N.PLATE_ROWS) + len(N.ROD_RESOLUTIONS)
+                             + len(N.CROSS_SECTION_RESOLUTIONS))
 
 
 def test_at_the_papers_slenderness_the_runs_are_those_of_the_mesh_studies(tmp_path):

@@ -243,3 +243,33 @@ def test_fibre_strains_of_a_surface_built_from_the_rods_frames_fix_the_signs():
     fit = np.linalg.lstsq(np.array(columns), np.array(values), rcond=None)[0]
     assert fit[0] == pytest.approx(1.0, abs=0.02) and fit[1] == pytest.approx(1.0, abs=0.03)
     assert fit[2] == pytest.approx(-0.5, abs=0.03) and fit[3] == pytest.approx(1.0, abs=0.05)
+
+
+def test_torsion_warping_pairs_and_clamp_terms_match_their_definition_and_finite_differences():
+    """Eq. V discretely: E Gamma / 2 sum ((tau_{i+1}/l - tau_i/l) / d)^2 d over neighbouring nodes,
+    zero for a uniform twist rate; each clamp adds E Gamma (tau/l)^2 / l for the half edge to the
+    clamp point, where tau = 0. Partials against central differences (relative step 1e-6)."""
+    from ddg.energies.cross_section import torsion_warping, torsion_warping_stiffness
+
+    shape = CrossSectionModes(0.05, 1e-3, 1e9, 0.0, 2)
+    stiffness = torsion_warping_stiffness(shape)
+    assert stiffness == pytest.approx(1e9 * 1e-9 / 12 * 0.05**3 / 12, rel=1e-12)
+    ell = np.full(7, 0.01)
+    uniform = torsion_warping(np.full(7, 0.3), ell, ell[:-1], stiffness)
+    assert np.allclose(uniform[0], 0.0) and np.allclose(uniform[3], stiffness * (0.3 / 0.01) ** 2 / 0.01)
+    rng = np.random.default_rng(2)
+    tau = rng.standard_normal(7)
+    energy, first, second, ends, end_first, end_second = torsion_warping(tau, ell, ell[:-1], stiffness)
+    h = 1e-6
+    for a in range(7):
+        tp, tm = tau.copy(), tau.copy()
+        tp[a] += h
+        tm[a] -= h
+        (ep, _, _, endp, _, _), (em, _, _, endm, _, _) = (torsion_warping(tp, ell, ell[:-1], stiffness),
+                                                           torsion_warping(tm, ell, ell[:-1], stiffness))
+        fd_total = (ep.sum() + endp.sum() - em.sum() - endm.sum()) / (2 * h)
+        exact = sum(first[i, j] for i in range(6) for j in range(2) if i + j == a)
+        exact += end_first[0] if a == 0 else end_first[1] if a == 6 else 0.0
+        assert fd_total == pytest.approx(exact, rel=1e-7, abs=1e-12 * np.abs(first).max())
+    assert np.allclose(second[:, 0, 0] * ell[0] ** 2 * 0.01, stiffness)
+    assert np.allclose(end_second, ends * 2 / tau[[0, 6]] ** 2)

@@ -270,7 +270,7 @@ ROD_MODELS = ("rod", "ribbon zeta=0.5L", "ribbon zeta=10L", "ribbon-sano-wada", 
 #: The energy parts each rod-family model reports beyond the rod's stretching, bending, twisting.
 EXTRA_PARTS = {"rod": set(), "ribbon zeta=0.5L": {"sadowsky"}, "ribbon zeta=10L": {"sadowsky"},
                "ribbon-sano-wada": {"sadowsky"}, "ribbon-trapeze": {"trapeze"},
-               "ribbon-cross-section": {"cross_section"},
+               "ribbon-cross-section": {"cross_section", "torsion_warping"},
                "ribbon-wunderlich": {"sadowsky", "wunderlich"}}
 #: Parts that may be negative: the trapeze coupling E b W^3 eps tau^2 / 24 where the centreline
 #: is compressed (eps < 0); with the stretching it forms a non-negative square (ddg.energies.trapeze).

@@ -68,6 +68,19 @@ Its limits, all exact:
   modes and overestimates it by up to 31 % (k = 6) with one (tests/test_cross_section.py). As
   k -> infinity both give Sadowsky's ribbon, (D W / 2)(kappa^2 + tau^2)^2 / kappa^2.
 
+The rotation of the cross-section, w = theta y (its rigid part, the rod's twist angle), bends
+the fibres when the twist rate changes: w_xx = tau' y adds (D / 2) int tau'^2 y^2 dy, so per unit
+length
+
+    E Gamma tau'^2 / 2,  E Gamma = D W^3 / 12,                                                   (V)
+
+the torsion-warping (Vlasov) stiffness of a thin strip, with tau = 0 at a clamp: a clamp holds
+w_x = 0 along its whole width, so theta' = 0 there, which the rod's clamp (theta alone) does not.
+Twist rises from the clamp over the boundary layer sqrt(E Gamma / G J) = W / sqrt(24 (1 - nu)),
+0.20 W for nu = 0, where the U's twist is largest under shear; dropping it put the pitchfork dW1/L
+0.02 above the shell's at W/L = 1/20 (L/b = 100, 300). Its c'' parts (the modes' w_xx) are of the
+second order left out above.
+
 Why a field and not the point-wise elimination: eliminating c point by point gives a density that
 is not convex in kappa where the twist is strong and the curvature small (W^2 tau / b above
 22680^(1/4) / sqrt(3) = 7.1 for nu = 0: an inflection point of a twisted strip), and the discrete
@@ -95,7 +108,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CrossSectionModes", "field_density", "local_optimum", "psi", "foundation_share", "SERIES_BELOW"]
+__all__ = ["CrossSectionModes", "field_density", "torsion_warping", "torsion_warping_stiffness", "local_optimum",
+           "psi", "foundation_share", "SERIES_BELOW"]
 
 
 def _width_integral(power: np.ndarray | int, width: float):
@@ -256,6 +270,41 @@ def field_density(eps, kappa, kappa_g, tau, c_before, c_after, voronoi_lengths, 
     second[:, before, after] -= dcdc
     second[:, after, before] -= dcdc
     return energy, first, second
+
+
+def torsion_warping_stiffness(modes: CrossSectionModes) -> float:
+    """E Gamma = D W^3 / 12: the bending of the fibres of a cross-section whose rotation theta(x)
+    changes at a changing rate (w = theta y, w_xx = tau' y), Eq. V."""
+    return modes.plate * modes.width**3 / 12.0
+
+
+def torsion_warping(tau, voronoi_lengths, pair_lengths, stiffness: float):
+    """Eq. V discretely: E Gamma / 2 int tau'^2, tau' between neighbouring nodes i, i + 1 as
+    (tau_{i+1} / l_{i+1} - tau_i / l_i) / d_i (d_i their distance, the rest length of the edge
+    between them), and at each clamp, where tau = 0, over the half edge between the clamp point and
+    the first interior node: E Gamma (tau_0 / l_0)^2 / h_0 and likewise at the end.
+
+    Returns the pairs' energies (n - 1,), partials (n - 1, 2) and second partials (n - 1, 2, 2) in
+    (tau_i, tau_{i+1}) (integrated twists, Eq. 5), then the two clamp terms' energies (2,),
+    partials (2,) and second partials (2,) in tau_0 and tau_{n-1}."""
+    tau = np.asarray(tau, dtype=float)
+    ell = np.asarray(voronoi_lengths, dtype=float)
+    rate = tau / ell
+    a, b = 1.0 / ell[:-1], 1.0 / ell[1:]
+    jump = rate[1:] - rate[:-1]
+    k = stiffness / np.asarray(pair_lengths, dtype=float)
+    energy = 0.5 * k * jump * jump
+    first = np.stack([-k * jump * a, k * jump * b], axis=1)
+    second = np.empty((len(jump), 2, 2))
+    second[:, 0, 0] = k * a * a
+    second[:, 1, 1] = k * b * b
+    second[:, 0, 1] = second[:, 1, 0] = -k * a * b
+    # the clamps: tau = 0 at s = 0 and L; the clamp point is the clamped edge's midpoint, so the
+    # first node is half an edge, l_0 / 2 on the uniform centreline, from it
+    ends = np.array([0, len(tau) - 1])
+    c = stiffness / (0.5 * ell[ends]) / ell[ends] ** 2
+    end_energy = 0.5 * c * tau[ends] ** 2
+    return energy, first, second, end_energy, c * tau[ends], c
 
 
 def local_optimum(kappa, tau, modes: CrossSectionModes):

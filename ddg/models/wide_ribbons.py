@@ -29,7 +29,8 @@ import math
 
 import numpy as np
 
-from ..energies.cross_section import CrossSectionModes, field_density
+from ..energies.cross_section import (CrossSectionModes, field_density, torsion_warping,
+                                      torsion_warping_stiffness)
 from ..energies.rod_curvature import material_curvatures
 from ..energies.sadowsky import check_zeta
 from ..energies.stencil_coupling import (add_local_terms, add_placed_terms, pair_blocks, stencil_strain_blocks,
@@ -106,11 +107,15 @@ class CrossSectionRibbon(RodModel):
         self.modes = CrossSectionModes(strip.width, strip.thickness, strip.young_modulus, strip.poisson_ratio,
                                        self.edge_fields)
         stride = self.node_stride
-        self.bandwidth = 2 * stride + 2  # a stencil spans x_{i-1} .. x_{i+1}: 2 stride + 3 DOFs
         # where the stencil's rod strains (over the rod's 11 DOFs) and its edges' modes sit in its block
         self._rod_place = np.array([a + (a // 4) * (stride - 4) for a in range(11)])
         n = self.edge_fields
         self._mode_place = np.r_[4 + np.arange(n), stride + 4 + np.arange(n)]
+        # Eq. V: the torsion-warping of the cross-section, over pairs of stencils (3 stride + 3 DOFs)
+        self.warping_stiffness = torsion_warping_stiffness(self.modes)
+        self.pair_lengths = self.rest_edge_lengths[1:-1]
+        self._pair_place = np.array([a + (a // 4) * (stride - 4) for a in range(15)])
+        self.bandwidth = 3 * stride + 2  # a pair of stencils spans x_{i-1} .. x_{i+2}: 3 stride + 3 DOFs
 
     def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
         c = q[self.field_dofs]
@@ -124,7 +129,19 @@ class CrossSectionRibbon(RodModel):
             strain_hess = np.concatenate([eps_hess[:, None], hessians], axis=1)
             add_placed_terms(self.node_stride * np.arange(len(eps)), self._rod_place, strain_grads, strain_hess,
                              self._mode_place, first, second, self.n_dof, grad, band, hessian)
-        return {"cross_section": float(energy.sum())}
+        pairs, pair_first, pair_second, ends, end_first, end_second = torsion_warping(
+            tau, self.voronoi_lengths, self.pair_lengths, self.warping_stiffness)
+        if gradient:
+            none = np.empty(0, dtype=np.int64)
+            pg, ph = pair_blocks(grads, hessians, (_TAU,))
+            add_placed_terms(self.node_stride * np.arange(len(pairs)), self._pair_place, pg, ph, none,
+                             pair_first, pair_second, self.n_dof, grad, band, hessian)
+            last = len(eps) - 1
+            add_placed_terms(self.node_stride * np.array([0, last]), self._rod_place,
+                             np.ascontiguousarray(grads[[0, last]][:, [_TAU]]),
+                             np.ascontiguousarray(hessians[[0, last]][:, [_TAU]]), none,
+                             end_first[:, None], end_second[:, None, None], self.n_dof, grad, band, hessian)
+        return {"cross_section": float(energy.sum()), "torsion_warping": float(pairs.sum() + ends.sum())}
 
     def cross_section(self, q: np.ndarray) -> np.ndarray:
         """The modes c^e (M - 1, n) of each edge's cross-section (c_1: transverse curvature, 1/m)."""

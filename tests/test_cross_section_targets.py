@@ -42,25 +42,26 @@ def _unmet(reason: str):
 
 #: (scene, quantity, bound, measured figures when not met)
 ACCURACY_CASES = [
-    ("dL0.5_W0.05_Lb1181", "dW1", 0.005, "dW1 0.3645 against 0.3511: error 0.0134"),
+    ("dL0.5_W0.05_Lb1181", "dW1", 0.005, None),
     ("dL0.5_W0.05_Lb1181", "dW2", 0.005, None),
-    ("dL0.5_W0.05_Lb1181", "H_mid", 0.01, "H_mid error 0.0211 (the shifted dW1 moves the path)"),
-    ("dL0.5_W0.08333_Lb1181", "dW1", 0.005, "dW1 0.2881 against 0.3275: error 0.0394 (M = 51, 101: none)"),
-    ("dL0.5_W0.08333_Lb1181", "dW2", 0.005, "no dW2: the path stops at a fold of US at dW/L 0.506"),
-    ("dL0.5_W0.08333_Lb1181", "H_mid", 0.01, "H_mid error 0.262"),
-    ("dL0.25_W0.05_Lb787", "dW1", 0.005, "dW1 0.2274 against 0.2187: error 0.0087"),
+    ("dL0.5_W0.05_Lb1181", "H_mid", 0.01, "H_mid error 0.0185 (M = 101: 0.0161)"),
+    ("dL0.5_W0.08333_Lb1181", "dW1", 0.005, "no dW1 at M = 201: the path stops on U (M = 101: 0.3088 against 0.3275)"),
+    ("dL0.5_W0.08333_Lb1181", "dW2", 0.005, "no dW2 (the shell's 0.4501)"),
+    ("dL0.5_W0.08333_Lb1181", "H_mid", 0.01, "no dW1, so the path stops before the pitchfork"),
+    ("dL0.25_W0.05_Lb787", "dW1", 0.005, None),
     ("dL0.25_W0.05_Lb787", "dW2", 0.005, None),
-    ("dL0.25_W0.05_Lb787", "H_mid", 0.01, "H_mid error 0.0112"),
-    ("dL0.25_W0.08333_Lb787", "dW1", 0.005, "dW1 0.2172 against 0.2084: error 0.0088"),
-    ("dL0.25_W0.08333_Lb787", "dW2", 0.005, "no dW2 at M = 201 (the path stops; M = 101: error 0.0015)"),
-    ("dL0.25_W0.08333_Lb787", "H_mid", 0.01, "H_mid error 0.0135"),
-    ("dL0.5_W0.1667_Lb1181", "dW1", 0.01, "dW1 0.1660 against 0.2654: error 0.0994"),
+    ("dL0.25_W0.05_Lb787", "H_mid", 0.01, None),
+    ("dL0.25_W0.08333_Lb787", "dW1", 0.005, "dW1 0.2180 against 0.2084: error 0.0096 (M = 101: 0.0057)"),
+    ("dL0.25_W0.08333_Lb787", "dW2", 0.005, "no dW2 at M = 201, the path stops in US (M = 101: error 0.0033)"),
+    ("dL0.25_W0.08333_Lb787", "H_mid", 0.01, None),
+    ("dL0.5_W0.1667_Lb1181", "dW1", 0.01, "no dW1 at M = 201 (M = 101: 0.1933 against 0.2654)"),
     ("dL0.5_W0.1667_Lb1181", "dW2", 0.01, "no dW2 (the shell's 0.4308)"),
-    ("dL0.25_W0.1667_Lb787", "dW1", 0.01, "no dW1 at M = 201 (M = 51: 0.1186 against 0.1610)"),
+    ("dL0.25_W0.1667_Lb787", "dW1", 0.01, "no dW1 at M = 201 (M = 101: 0.1820 against 0.1610)"),
     ("dL0.25_W0.1667_Lb787", "dW2", 0.01, "no dW2 (the shell's 0.2594)"),
-    ("dL0.5_W0.05_Lb300", "dW1", 0.005, "dW1 0.3610 against 0.3393: error 0.0217 (the rod's 0.3571)"),
+    ("dL0.5_W0.05_Lb300", "dW1", 0.005, None),
     ("dL0.5_W0.05_Lb300", "dW2", 0.005, None),
-    ("dL0.5_W0.05_Lb4000", "dW1", 0.005, "no dW1: the path stops on U (the shell's 0.3466 +- 0.0573)"),
+    ("dL0.5_W0.05_Lb4000", "dW1", 0.005, "dW1 0.3182 against the shell's 0.3466 +- 0.0573: error 0.0284 (M = 51 "
+                                          "and 101 stop before it)"),
 ]
 
 
@@ -69,20 +70,24 @@ ACCURACY_CASES = [
     for scene, quantity, bound, figures in ACCURACY_CASES])
 def test_cross_section_model_is_within_the_issues_bound_of_the_converged_fem(scene, quantity, bound):
     """|model - FEM| (the error map's error column, M = 201) within the issue's bound; a missing
-    value (no threshold found, or H_mid compared nowhere) is not met."""
-    error = _value(_row(scene), f"{quantity}_error")
+    value (no threshold found, or H_mid compared nowhere) is not met, nor is H_mid on a path that
+    stops before its pitchfork (it is then compared on the U branch's start only)."""
+    row = _row(scene)
+    error = _value(row, f"{quantity}_error")
+    if quantity == "H_mid":
+        assert _value(row, "dW1") is not None, "the path has no pitchfork"
     assert error is not None and error <= bound, error
 
 
 #: (scene, quantity, measured |M101 - M201|) of the narrow target scenes.
 CONVERGENCE_CASES = [
-    ("dL0.5_W0.05_Lb1181", "dW1", "0.3592 / 0.3645: 0.0053"),
+    ("dL0.5_W0.05_Lb1181", "dW1", "0.3491 / 0.3537: 0.0046"),
     ("dL0.5_W0.05_Lb1181", "dW2", None),
-    ("dL0.25_W0.05_Lb787", "dW1", "0.2262 / 0.2274: 0.0012"),
-    ("dL0.25_W0.05_Lb787", "dW2", "0.3341 / 0.3354: 0.0013"),
-    ("dL0.25_W0.08333_Lb787", "dW1", "0.2189 / 0.2172: 0.0017"),
-    ("dL0.25_W0.08333_Lb787", "dW2", "M = 201 has none (M = 101: 0.3014)"),
-    ("dL0.5_W0.08333_Lb1181", "dW1", "M = 101 has none (M = 201: 0.2881)"),
+    ("dL0.25_W0.05_Lb787", "dW1", None),
+    ("dL0.25_W0.05_Lb787", "dW2", None),
+    ("dL0.25_W0.08333_Lb787", "dW1", "0.2141 / 0.2180: 0.0039"),
+    ("dL0.25_W0.08333_Lb787", "dW2", "M = 201 has none (M = 101: 0.2996)"),
+    ("dL0.5_W0.08333_Lb1181", "dW1", "M = 201 has none (M = 101: 0.3088)"),
 ]
 
 
@@ -101,8 +106,8 @@ def test_map_has_the_models_rows_on_every_scene_at_three_resolutions():
     assert {(r["scene"], r["resolution_label"]) for r in rows} == expected
 
 
-@pytest.mark.xfail(strict=True, reason="wall time 2.0x to 27.8x the rod's at the same M on the four narrow scenes "
-                                       "(benchmarks/results/cross_section_path.md): 2585-8267 Newton iterations "
+@pytest.mark.xfail(strict=True, reason="wall time 4.5x to 45x the rod's at the same M on the four narrow scenes "
+                                       "(benchmarks/results/cross_section_path.md): 3662-10289 Newton iterations "
                                        "against the rod's 857-1401, every cross-section path stopping at a fold; the "
                                        "target is 2x")
 def test_wall_time_is_at_most_twice_the_rods():

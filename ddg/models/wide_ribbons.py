@@ -16,9 +16,10 @@ or replaces the rod's bending and twisting (Eqs. 6b, 6c) with a ribbon energy of
   modes of the transverse deflection per edge (DOFs after each twist angle), which bend to relieve
   the edges' stretching under twist (ddg.energies.cross_section, after Audoly and Neukirch 2021):
   the rod for a narrow strip, the trapeze ribbon where the cross-section cannot bend, Sadowsky's
-  ribbon for a wide one. It has more DOFs than the rod (6M - 3 against 4M - 1): the
-  cross-section's shape changes along the strip over about 0.4 W, which a density of the rod's
-  strains alone cannot hold (ddg.energies.cross_section, "Why a field").
+  ribbon for a wide one; and the torsion-warping of its rotation, with zero twist at the clamps
+  (Eq. V). It has more DOFs than the rod (6M - 3 against 4M - 1): the cross-section's shape
+  changes along the strip over about 0.4 W, which a density of the rod's strains alone cannot
+  hold (ddg.energies.cross_section, "Why a field").
 - `ribbon-wunderlich` (WunderlichRibbon): Wunderlich's finite-width developable ribbon, Eq. (A.2),
   regularised at inflection points as (A.5) is (ddg.energies.wunderlich); zeta defaults to the
   Sano-Wada value, and its effect is measured (validation/ribbon_regularisation.py).

@@ -108,7 +108,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CrossSectionModes", "field_density", "torsion_warping", "torsion_warping_stiffness", "local_optimum",
+__all__ = ["CrossSectionModes", "field_density", "modes_curvature_form", "torsion_warping", "torsion_warping_stiffness",
+           "local_optimum",
            "psi", "foundation_share", "SERIES_BELOW"]
 
 
@@ -305,6 +306,51 @@ def torsion_warping(tau, voronoi_lengths, pair_lengths, stiffness: float):
     c = stiffness / (0.5 * ell[ends]) / ell[ends] ** 2
     end_energy = 0.5 * c * tau[ends] ** 2
     return energy, first, second, end_energy, c * tau[ends], c
+
+
+def modes_curvature_form(field_dofs: np.ndarray, spacing: float, modes: CrossSectionModes):
+    """Eq. X': the modes' bending along the strip, (D / 2) int [c'' . R c'' + 2 nu c'' . N c] dx,
+    R_ij = int (B_i - <B_i>)(B_j - <B_j>) dy, N_ij = int (B_i - <B_i>) y^(2j - 2) dy, with c'' the
+    second difference of the edges' modes, (c^{e+1} - 2 c^e + c^{e-1}) / h^2 over each interior edge
+    (weight h), and c' = 0 at the clamp points, the clamped edges' midpoints (ghost c^{-1} = c^1,
+    weight h / 2), since a clamp holds w_x = 0 across its width. A constant quadratic form in the
+    DOFs: returns its lower triangle (rows, cols, values), rows >= cols, on a uniform centreline of
+    spacing h; field_dofs (M - 1, n) the modes' DOFs per edge."""
+    n = modes.modes
+    r = np.asarray(modes.S)[1:1 + n, 1:1 + n] * modes.plate
+    j = np.arange(1, n + 1)
+    w = modes.width
+    centred = np.r_[2 * j]  # B_j - <B_j> against y^(2k - 2): int B_j y^(2k-2) - <B_j> int y^(2k-2)
+    raw = _width_integral(centred[:, None] + (2 * j - 2)[None, :], w) / ((2 * j - 1) * 2.0 * j)[:, None]
+    mean = (_width_integral(2 * j, w) / ((2 * j - 1) * 2.0 * j) / w)[:, None] * _width_integral(2 * j - 2, w)[None, :]
+    coupling = modes.plate * modes.poisson_ratio * (raw - mean)
+    h = float(spacing)
+    edges = field_dofs.shape[0]
+    entries = {}
+
+    def add(second, weight, own=None):
+        """second: [(edge, coefficient)] of c'' at one edge; own: that edge (for the nu term)."""
+        for e1, a1 in second:
+            for e2, a2 in second:
+                block = weight * a1 * a2 * r
+                for i in range(n):
+                    for k in range(n):
+                        key = (field_dofs[e1, i], field_dofs[e2, k])
+                        entries[key] = entries.get(key, 0.0) + block[i, k]
+            if own is not None and modes.poisson_ratio != 0.0:
+                block = weight * a1 * coupling
+                for i in range(n):
+                    for k in range(n):
+                        for key in ((field_dofs[e1, i], field_dofs[own, k]), (field_dofs[own, k], field_dofs[e1, i])):
+                            entries[key] = entries.get(key, 0.0) + block[i, k]
+
+    for e in range(1, edges - 1):
+        add([(e - 1, 1.0 / h**2), (e, -2.0 / h**2), (e + 1, 1.0 / h**2)], h, own=e)
+    add([(0, -2.0 / h**2), (1, 2.0 / h**2)], 0.5 * h)
+    add([(edges - 1, -2.0 / h**2), (edges - 2, 2.0 / h**2)], 0.5 * h)
+    lower = [(row, col, value) for (row, col), value in entries.items() if row >= col]
+    rows, cols, values = (np.array(x) for x in zip(*lower))
+    return rows.astype(np.int64), cols.astype(np.int64), values.astype(float)
 
 
 def local_optimum(kappa, tau, modes: CrossSectionModes):

@@ -273,3 +273,44 @@ def test_torsion_warping_pairs_and_clamp_terms_match_their_definition_and_finite
         assert fd_total == pytest.approx(exact, rel=1e-7, abs=1e-12 * np.abs(first).max())
     assert np.allclose(second[:, 0, 0] * ell[0] ** 2 * 0.01, stiffness)
     assert np.allclose(end_second, ends * 2 / tau[[0, 6]] ** 2)
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3])
+def test_modes_bending_form_is_the_sum_of_its_second_differences(nu):
+    """Eq. X' as the constant quadratic form the model adds: 1/2 q.K q equals (D/2) sum h [c''.R c'' +
+    2 nu c''.N c] over the interior edges plus the two clamp edges' ghost terms (c' = 0 there,
+    weight h/2, where the mode itself is clamped to 0); K is symmetric and a constant field has
+    none of it."""
+    from ddg.energies.cross_section import modes_curvature_form
+
+    shape = CrossSectionModes(0.05, 1e-3, 1e9, nu, 2)
+    edges, h = 9, 0.01
+    field_dofs = np.arange(edges * 2).reshape(edges, 2)
+    rows, cols, values = modes_curvature_form(field_dofs, h, shape)
+    assert np.all(rows >= cols)
+    k = np.zeros((edges * 2, edges * 2))
+    np.add.at(k, (rows, cols), values)
+    k = k + k.T - np.diag(np.diag(k))
+    c = np.random.default_rng(4).standard_normal((edges, 2)) * [10.0, 1e3]
+    c[0] = c[-1] = 0.0
+    d = 1e9 * 1e-9 / (12 * (1 - nu * nu))
+    r = shape.S[1:3, 1:3] * d
+    j = np.arange(1, 3)
+    mean = _width(2 * j) / ((2 * j - 1) * 2 * j) / 0.05
+    n_matrix = d * nu * np.array([[_width(2 * a + 2 * b - 2) / ((2 * a - 1) * 2 * a) - mean[a - 1] * _width(2 * b - 2)
+                                   for b in (1, 2)] for a in (1, 2)])
+    direct = 0.0
+    for e in range(1, edges - 1):
+        second = (c[e + 1] - 2 * c[e] + c[e - 1]) / h**2
+        direct += 0.5 * h * (second @ r @ second + 2 * second @ n_matrix @ c[e])
+    for end, inner in ((0, 1), (edges - 1, edges - 2)):
+        second = 2 * (c[inner] - c[end]) / h**2
+        direct += 0.25 * h * (second @ r @ second)
+    q = c.ravel()
+    assert 0.5 * q @ k @ q == pytest.approx(direct, rel=1e-12)
+    constant = np.tile([3.0, -40.0], edges)
+    assert abs(constant @ k @ constant) < 1e-9 * abs(q @ k @ q)
+
+
+def _width(power):
+    return 2.0 * 0.025 ** (power + 1) / (power + 1)

@@ -47,9 +47,17 @@ c' = dc/dx. The last two terms are the energy of a cross-section whose shape cha
 strip (w_xy = sum_j c_j' y^(2j - 1) / (2j - 1)): its twisting, and the odd membrane strain that
 Gauss's -2 tau w_xy makes of it, about (W^2 tau / b)^2 / 56 times the twisting for one mode. They
 make c a field with an adaptation length, 0.41 W (1 - nu)^(1/2) where kappa = tau = 0, shorter
-under twist. Not kept: the terms quadratic in the x-derivatives of c in the membrane strain
-(w_xy^2 - w_xx w_yy of Eq. F) and in the bending (w_xx^2); the first-order term of w_xx in the
-bending, D kappa int w_xx, vanishes by the centroid convention.
+under twist. The modes' own bending along the strip, w_xx = sum_j c_j'' (B_j - <B_j>), adds
+
+    (D / 2) [c'' . R c'' + 2 nu c'' . N c],  R_ij = int (B_i - <B_i>)(B_j - <B_j>) dy,
+    N_ij = int (B_i - <B_i>) y^(2j - 2) dy,                                                    (X')
+
+with c' = 0 at a clamp (it holds w_x = 0 across its width): where the modes change over less than
+W (their layer at a clamp, about W / sqrt(kappa W^2 / b) long) it outweighs the c'^2 term, and
+without it the pitchfork moved with M (W/L = 1/12, dL/L = 1/2: dW1/L 0.3088, 0.3345, 0.3396 at
+M = 101, 201, 401). Not kept: the terms quadratic in the x-derivatives of c in the membrane strain
+(w_xy^2 - w_xx w_yy of Eq. F); the first-order term of w_xx in the bending, D kappa int w_xx,
+vanishes by the centroid convention.
 
 Its limits, all exact:
 - c = 0 (the cross-section kept straight): f = E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640, the

@@ -86,8 +86,7 @@ the torsion-warping (Vlasov) stiffness of a thin strip, with tau = 0 at a clamp:
 w_x = 0 along its whole width, so theta' = 0 there, which the rod's clamp (theta alone) does not.
 Twist rises from the clamp over the boundary layer sqrt(E Gamma / G J) = W / sqrt(24 (1 - nu)),
 0.20 W for nu = 0, where the U's twist is largest under shear; dropping it put the pitchfork dW1/L
-0.02 above the shell's at W/L = 1/20 (L/b = 100, 300). Its c'' parts (the modes' w_xx) are of the
-second order left out above.
+0.02 above the shell's at W/L = 1/20 (L/b = 100, 300). The modes' part of w_xx is Eq. X'.
 
 Why a field and not the point-wise elimination: eliminating c point by point gives a density that
 is not convex in kappa where the twist is strong and the curvature small (W^2 tau / b above
@@ -104,11 +103,13 @@ midpoints of its edges), kappa -> kappa_i / l, tau -> tau_i / l (the rod's integ
 eps -> the Voronoi mean stretch (ddg.energies.stencil_coupling), c -> (c^{i-1} + c^i) / 2 and
 c' -> (c^i - c^{i-1}) / l:
 
-    E_i = l f(eps_i, kappa_i / l, tau_i / l, (c^{i-1} + c^i) / 2) + D (1 - nu) dc . Q dc / l,
-    dc = c^i - c^{i-1}.
+    E_i = l f(eps_i, kappa_i / l, tau_i / l, (c^{i-1} + c^i) / 2) with c' = dc / l, dc = c^i - c^{i-1}
+    (the c' terms of Eq. X, kappa_g -> kappa_g_i / l).
 
 `field_density` returns E_i and its exact first and second partials in the stencil's strains
-(eps, kappa_i, tau_i, c^{i-1}, c^i): f is a polynomial.
+(eps, kappa_i, kappa_g_i, tau_i, c^{i-1}, c^i): f is a polynomial. Eq. X' is a constant quadratic
+form in the modes (`modes_curvature_form`, second differences over three edges); Eq. V couples
+neighbouring stencils' twists (`torsion_warping`).
 """
 from __future__ import annotations
 

@@ -270,6 +270,15 @@ def strain_derivatives(x: np.ndarray, m1: np.ndarray, m2: np.ndarray):
 
 
 @njit(cache=True)
+def stencil_place(size, node_stride):
+    """Where the rod's DOFs of a block of `size` (11: a stencil, 15: a pair of stencils) sit in the
+    block of a model with node_stride DOFs per node (the rod's 4, or 4 + its edge fields after each
+    twist angle): local DOF a goes to a + (a // 4) (node_stride - 4)."""
+    place = np.arange(size)
+    return place + (place // 4) * (node_stride - 4)
+
+
+@njit(cache=True)
 def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, want_hessian):
     """Chain rule for an energy sum_i e(kappa_n, kappa_g, tau) of the stencils: adds its gradient
     to grad and (want_hessian) its Hessian to the flattened lower band of an n_dof matrix.
@@ -287,9 +296,7 @@ def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, 
     eth = np.empty((3, 2))
     fth = np.empty((3, 2))
     thth = np.empty(2)
-    place = np.empty(STENCIL_SIZE, dtype=np.int64)  # the stencil's 11 DOFs within its block
-    for a in range(STENCIL_SIZE):
-        place[a] = a + (a // 4) * (node_stride - 4)
+    place = stencil_place(STENCIL_SIZE, node_stride)  # the stencil's 11 DOFs within its block
     for i in range(x.shape[0] - 2):
         _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1],
                  strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w)

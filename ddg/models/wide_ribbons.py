@@ -32,7 +32,7 @@ import numpy as np
 
 from ..energies.cross_section import (CrossSectionModes, field_density, modes_curvature_form, torsion_warping,
                                       torsion_warping_stiffness)
-from ..energies.rod_curvature import material_curvatures
+from ..energies.rod_curvature import material_curvatures, stencil_place
 from ..energies.sadowsky import check_zeta
 from ..energies.stencil_coupling import (add_local_terms, add_placed_terms, pair_blocks, stencil_strain_blocks,
                                          stencil_stretch)
@@ -104,8 +104,8 @@ def _symmetric_csr(rows, cols, values, n: int):
 
 
 class CrossSectionRibbon(RodModel):
-    """The DAR plus its cross-section as a field (ddg.energies.cross_section, Eq. X): `modes` DOFs
-    per edge after the twist angle (node_stride 4 + modes), zero on the clamped edges."""
+    """The DAR plus its cross-section as a field (ddg.energies.cross_section, Eqs. X, X' and V):
+    `modes` DOFs per edge after the twist angle (node_stride 4 + modes), zero on the clamped edges."""
 
     name = "ribbon-cross-section"
     edge_fields = 2
@@ -118,17 +118,17 @@ class CrossSectionRibbon(RodModel):
                                        self.edge_fields)
         stride = self.node_stride
         # where the stencil's rod strains (over the rod's 11 DOFs) and its edges' modes sit in its block
-        self._rod_place = np.array([a + (a // 4) * (stride - 4) for a in range(11)])
+        self._rod_place = stencil_place(11, stride)
         n = self.edge_fields
         self._mode_place = np.r_[4 + np.arange(n), stride + 4 + np.arange(n)]
         # Eq. V: the torsion-warping of the cross-section, over pairs of stencils (3 stride + 3 DOFs)
         self.warping_stiffness = torsion_warping_stiffness(self.modes)
         self.pair_lengths = self.rest_edge_lengths[1:-1]
-        self._pair_place = np.array([a + (a // 4) * (stride - 4) for a in range(15)])
+        self._pair_place = stencil_place(15, stride)
         self.bandwidth = 3 * stride + 2  # a pair of stencils spans x_{i-1} .. x_{i+2}: 3 stride + 3 DOFs
         # the modes' bending along the strip, a constant quadratic form in the DOFs (Eq. X')
         rows, cols, values = modes_curvature_form(self.field_dofs, self.centerline.spacing, self.modes)
-        self._curvature_form = (rows, cols, values)
+        self._curvature_band = ((rows - cols) * self.n_dof + cols, values)  # distinct entries of the band
         self._curvature_matrix = _symmetric_csr(rows, cols, values, self.n_dof)
 
     def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
@@ -159,8 +159,8 @@ class CrossSectionRibbon(RodModel):
         if gradient:
             grad += curvature_force
             if hessian:
-                rows, cols, values = self._curvature_form
-                np.add.at(band, (rows - cols) * self.n_dof + cols, values)
+                where, values = self._curvature_band
+                band[where] += values
         return {"cross_section": float(energy.sum()), "torsion_warping": float(pairs.sum() + ends.sum()),
                 "cross_section_bending": 0.5 * float(q @ curvature_force)}
 
@@ -186,10 +186,7 @@ class CrossSectionRibbon(RodModel):
         metric, unit = super().eigenvalue_metric()
         full = np.zeros(self.n_dof)
         full[self.free] = metric
-        modes = self.modes
-        w = self.strip.width
-        mean = modes.m[1:] / w
-        variance = (np.diag(modes.S)[1:] - w * mean**2) / w
+        variance = np.diag(self.modes.S)[1:] / self.strip.width  # the modes are centred (Eq. X)
         full[self.field_dofs] = self.centerline.spacing * variance[None, :]
         return full[self.free], unit
 

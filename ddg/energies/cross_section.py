@@ -116,6 +116,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 __all__ = ["CrossSectionModes", "field_density", "modes_curvature_form", "torsion_warping", "torsion_warping_stiffness",
            "local_optimum",
@@ -168,6 +169,15 @@ class CrossSectionModes:
                            / (d[:, None] * d[None, :]))
 
     @property
+    def constant_hessian(self) -> np.ndarray:
+        """The Hessian of G = E b [eps m . v + v . S v / 2] in (eps, v) (Eq. X), (n + 2, n + 2)."""
+        n = self.modes
+        h_g = np.zeros((n + 2, n + 2))
+        h_g[0, 1:] = h_g[1:, 0] = self.membrane * self.m
+        h_g[1:, 1:] = self.membrane * self.S
+        return h_g
+
+    @property
     def membrane(self) -> float:
         """E b: the membrane stiffness per unit width."""
         return self.young_modulus * self.thickness
@@ -179,106 +189,189 @@ class CrossSectionModes:
         return self.young_modulus * self.thickness**3 / (12.0 * (1.0 - nu * nu))
 
 
+@njit(cache=True)
+def _point_terms(eps, k, t, c, m, s, big_p, p, eb, d, nu, width, jac, h_g, g_w, f_z, f_zz):
+    """f of (X) without its c' terms at one point z = (eps, kappa, tau, c_1 .. c_n): returns f and
+    fills its partials f_z (3 + n) and second partials f_zz (3 + n, 3 + n); jac (n + 2, 3 + n),
+    h_g (n + 2, n + 2) and g_w (n + 2) are work arrays (h_g holds the constant Hessian of G)."""
+    n = c.shape[0]
+    size = 3 + n
+    # G(eps, v) = E b [eps m . v + v . S v / 2], v = (tau^2, -kappa c_1, .., -kappa c_n)
+    mv = m[0] * t * t
+    for j in range(n):
+        mv -= m[1 + j] * k * c[j]
+    vsv = 0.0
+    for a in range(n + 1):
+        va = t * t if a == 0 else -k * c[a - 1]
+        sva = s[a, 0] * t * t
+        for b in range(n):
+            sva -= s[a, 1 + b] * k * c[b]
+        vsv += va * sva
+        g_w[1 + a] = eb * (eps * m[a] + sva)
+    g_w[0] = eb * mv
+    value = eb * (eps * mv + 0.5 * vsv)
+    # w = (eps, v) as functions of z: its Jacobian, then f_z = J^T g_w, f_zz = J^T h_G J + sum g_w w''
+    for a in range(n + 2):
+        for b in range(size):
+            jac[a, b] = 0.0
+    jac[0, 0] = 1.0
+    jac[1, 2] = 2.0 * t
+    for j in range(n):
+        jac[2 + j, 1] = -c[j]
+        jac[2 + j, 3 + j] = -k
+    for b in range(size):
+        acc = 0.0
+        for a in range(n + 2):
+            acc += jac[a, b] * g_w[a]
+        f_z[b] = acc
+    for b in range(size):
+        for e in range(b, size):
+            acc = 0.0
+            for a in range(n + 2):
+                if jac[a, b] != 0.0:
+                    for r in range(n + 2):
+                        acc += jac[a, b] * h_g[a, r] * jac[r, e]
+            f_zz[b, e] = acc
+            f_zz[e, b] = acc
+    f_zz[2, 2] += 2.0 * g_w[1]                    # d2 (tau^2) / dtau2
+    for j in range(n):                            # d2 (-kappa c_j) / dkappa dc_j
+        f_zz[1, 3 + j] -= g_w[2 + j]
+        f_zz[3 + j, 1] -= g_w[2 + j]
+    # the plate's bending beyond the rod's: (D / 2) [c . P c + 2 nu kappa p . c + nu^2 W kappa^2]
+    pc_c = 0.0
+    p_c = 0.0
+    for i in range(n):
+        pci = 0.0
+        for j in range(n):
+            pci += big_p[i, j] * c[j]
+            f_zz[3 + i, 3 + j] += d * big_p[i, j]
+        pc_c += c[i] * pci
+        p_c += p[i] * c[i]
+        f_z[3 + i] += d * (pci + nu * k * p[i])
+        f_zz[1, 3 + i] += d * nu * p[i]
+        f_zz[3 + i, 1] += d * nu * p[i]
+    value += 0.5 * d * (pc_c + 2.0 * nu * k * p_c + nu * nu * width * k * k)
+    f_z[1] += d * (nu * p_c + nu * nu * width * k)
+    f_zz[1, 1] += d * nu * nu * width
+    return value
+
+
+@njit(cache=True)
+def _point_kernel(eps, k, t, c, m, s, big_p, p, eb, d, nu, width, h_g, value, first, second):
+    n = c.shape[1]
+    jac = np.empty((n + 2, 3 + n))
+    g_w = np.empty(n + 2)
+    for i in range(len(eps)):
+        value[i] = _point_terms(eps[i], k[i], t[i], c[i], m, s, big_p, p, eb, d, nu, width, jac, h_g, g_w,
+                                first[i], second[i])
+
+
 def _point_density(eps, k, t, c, modes: CrossSectionModes):
     """f of (X) without its c' term at points (eps, k, t, c (N, n)): values (N,), partials (N, 3 + n)
     and second partials (N, 3 + n, 3 + n) in z = (eps, kappa, tau, c_1 .. c_n)."""
-    n = modes.modes
-    eb, d, nu = modes.membrane, modes.plate, modes.poisson_ratio
-    size = 3 + n
-    count = len(eps)
-    v = np.empty((count, n + 1))
-    v[:, 0] = t * t
-    v[:, 1:] = -k[:, None] * c
-    # G(eps, v) = E b [eps m . v + v . S v / 2]: its gradient and (constant) Hessian in (eps, v)
-    sv = v @ modes.S
-    g_w = np.empty((count, n + 2))
-    g_w[:, 0] = eb * (v @ modes.m)
-    g_w[:, 1:] = eb * (eps[:, None] * modes.m[None, :] + sv)
-    h_g = np.zeros((n + 2, n + 2))
-    h_g[0, 1:] = h_g[1:, 0] = eb * modes.m
-    h_g[1:, 1:] = eb * modes.S
-    # w = (eps, v) as functions of z: Jacobian and the nonzero second derivatives
-    jac = np.zeros((count, n + 2, size))
-    jac[:, 0, 0] = 1.0
-    jac[:, 1, 2] = 2.0 * t
-    jac[:, 2:, 1] = -c
-    idx = np.arange(n)
-    jac[:, 2 + idx, 3 + idx] = -k[:, None]
-    value = eb * (eps * (v @ modes.m) + 0.5 * np.einsum("na,na->n", v, sv))
-    jac_t = jac.transpose(0, 2, 1)
-    first = (jac_t @ g_w[:, :, None])[:, :, 0]
-    second = jac_t @ (h_g @ jac)
-    second[:, 2, 2] += 2.0 * g_w[:, 1]            # d2 (tau^2) / dtau2
-    second[:, 1, 3 + idx] += -g_w[:, 2:]           # d2 (-kappa c_j) / dkappa dc_j
-    second[:, 3 + idx, 1] += -g_w[:, 2:]
-    # the plate's bending beyond the rod's: (D / 2) [c . P c + 2 nu kappa p . c + nu^2 W kappa^2]
-    pc = c @ modes.P
-    value += 0.5 * d * (np.einsum("nj,nj->n", c, pc) + 2.0 * nu * k * (c @ modes.p) + nu * nu * modes.width * k * k)
-    first[:, 1] += d * (nu * (c @ modes.p) + nu * nu * modes.width * k)
-    first[:, 3:] += d * (pc + nu * k[:, None] * modes.p[None, :])
-    second[:, 1, 1] += d * nu * nu * modes.width
-    second[:, 1, 3:] += d * nu * modes.p
-    second[:, 3:, 1] += d * nu * modes.p
-    second[:, 3:, 3:] += d * modes.P
+    eps, k, t = (np.ascontiguousarray(a, dtype=float) for a in (eps, k, t))
+    c = np.ascontiguousarray(c, dtype=float)
+    count, n = c.shape
+    value, first, second = np.empty(count), np.empty((count, 3 + n)), np.empty((count, 3 + n, 3 + n))
+    _point_kernel(eps, k, t, c, modes.m, modes.S, modes.P, modes.p, modes.membrane, modes.plate,
+                  modes.poisson_ratio, modes.width, modes.constant_hessian, value, first, second)
     return value, first, second
+
+
+@njit(cache=True)
+def _field_kernel(eps, kappa, kappa_g, tau, c_before, c_after, ell, m, s, big_p, p, q, a, big_psi, eb, d, nu,
+                  width, h_g, energy, first, second):
+    count, n = c_before.shape
+    size = 4 + 2 * n
+    jac = np.empty((n + 2, 3 + n))
+    g_w = np.empty(n + 2)
+    f_z = np.empty(3 + n)
+    f_zz = np.empty((3 + n, 3 + n))
+    c_mean = np.empty(n)
+    dc = np.empty(n)
+    qdc = np.empty(n)
+    pdc = np.empty(n)
+    z_of_u = np.empty(size, np.int64)   # u = (eps, kappa, kappa_g, tau, c^{i-1}, c^i) -> z (-1: kappa_g)
+    z_of_u[0], z_of_u[1], z_of_u[2], z_of_u[3] = 0, 1, -1, 2
+    for j in range(n):
+        z_of_u[4 + j] = 3 + j
+        z_of_u[4 + n + j] = 3 + j
+    scale = np.empty(size)
+    g = d * (1.0 - nu)
+    for i in range(count):
+        l = ell[i]
+        for j in range(n):
+            c_mean[j] = 0.5 * (c_before[i, j] + c_after[i, j])
+        f = _point_terms(eps[i], kappa[i] / l, tau[i] / l, c_mean, m, s, big_p, p, eb, d, nu, width, jac, h_g, g_w,
+                         f_z, f_zz)
+        # u -> z = (eps, kappa / l, tau / l, (c^{i-1} + c^i) / 2): E_i = l f
+        scale[0], scale[1], scale[2], scale[3] = l, 1.0, 0.0, 1.0
+        for j in range(2 * n):
+            scale[4 + j] = 0.5 * l
+        fi = first[i]
+        se = second[i]
+        for r in range(size):
+            zr = z_of_u[r]
+            fi[r] = scale[r] * f_z[zr] if zr >= 0 else 0.0
+            for col in range(size):
+                zc = z_of_u[col]
+                se[r, col] = f_zz[zr, zc] * scale[r] * scale[col] / l if zr >= 0 and zc >= 0 else 0.0
+        # terms of dc = c^i - c^{i-1}: the twisting of a changing cross-section, D (1 - nu) dc . Q dc / l,
+        # and the odd strain -tau c' . psi(y): E b [kappa_g tau dc . a / l^2 + tau^2 dc . Psi dc / (2 l^3)]
+        for j in range(n):
+            dc[j] = c_after[i, j] - c_before[i, j]
+        qq = 0.0
+        adc = 0.0
+        dpd = 0.0
+        for j in range(n):
+            qj = 0.0
+            pj = 0.0
+            for r in range(n):
+                qj += q[j, r] * dc[r]
+                pj += big_psi[j, r] * dc[r]
+            qdc[j], pdc[j] = qj, pj
+            qq += dc[j] * qj
+            adc += a[j] * dc[j]
+            dpd += dc[j] * pj
+        kg, t = kappa_g[i], tau[i]
+        l2, l3 = l * l, l * l * l
+        energy[i] = l * f + g * qq / l + eb * (kg * t * adc / l2 + 0.5 * t * t * dpd / l3)
+        fi[2] += eb * t * adc / l2
+        fi[3] += eb * (kg * adc / l2 + t * dpd / l3)
+        se[2, 3] += eb * adc / l2
+        se[3, 2] += eb * adc / l2
+        se[3, 3] += eb * dpd / l3
+        for j in range(n):
+            d_dc = 2.0 * g * qdc[j] / l + eb * (kg * t / l2 * a[j] + t * t / l3 * pdc[j])
+            g_dc = eb * t / l2 * a[j]                                   # d2 / dkappa_g d(dc)
+            t_dc = eb * (kg / l2 * a[j] + 2.0 * t / l3 * pdc[j])        # d2 / dtau d(dc)
+            for block, sign in ((4, -1.0), (4 + n, 1.0)):
+                fi[block + j] += sign * d_dc
+                se[2, block + j] += sign * g_dc
+                se[block + j, 2] += sign * g_dc
+                se[3, block + j] += sign * t_dc
+                se[block + j, 3] += sign * t_dc
+            for r in range(n):
+                dcdc = 2.0 * g * q[j, r] / l + eb * t * t / l3 * big_psi[j, r]
+                se[4 + j, 4 + r] += dcdc
+                se[4 + n + j, 4 + n + r] += dcdc
+                se[4 + j, 4 + n + r] -= dcdc
+                se[4 + n + j, 4 + r] -= dcdc
 
 
 def field_density(eps, kappa, kappa_g, tau, c_before, c_after, voronoi_lengths, modes: CrossSectionModes):
     """E_i per stencil (N,) and its partials (N, 4 + 2n) and second partials (N, 4 + 2n, 4 + 2n) in
     the stencil's strains u = (eps_i, kappa_i, kappa_g_i, tau_i, c^{i-1}_1..n, c^i_1..n): kappa,
     kappa_g, tau the rod's integrated strains (Eqs. 3-5), eps the Voronoi mean stretch,
-    c_before/c_after (N, n) the cross-section modes of the stencil's two edges."""
-    n = modes.modes
-    ell = np.asarray(voronoi_lengths, dtype=float)
-    count = len(ell)
-    c_mean = 0.5 * (c_before + c_after)
-    f, f_z, f_zz = _point_density(eps, kappa / ell, tau / ell, c_mean, modes)
-    # u -> z = (eps, kappa / l, tau / l, (c_before + c_after) / 2): a diagonal scaling, then a copy
-    scale = np.empty((count, 3 + n))
-    scale[:, 0] = ell
-    scale[:, 1:3] = 1.0
-    scale[:, 3:] = 0.5 * ell[:, None]
-    z_of_u = np.r_[0, 1, 2, 3 + np.arange(n), 3 + np.arange(n)]
-    into = np.r_[0, 1, 3, 4 + np.arange(2 * n)]  # u without kappa_g, within u
+    c_before/c_after (N, n) the cross-section modes of the stencil's two edges. Compiled
+    (`_field_kernel`, one pass over the stencils)."""
+    arrays = [np.ascontiguousarray(x, dtype=float) for x in (eps, kappa, kappa_g, tau, c_before, c_after,
+                                                              voronoi_lengths)]
+    count, n = arrays[4].shape
     size = 4 + 2 * n
-    energy = ell * f
-    first = np.zeros((count, size))
-    second = np.zeros((count, size, size))
-    first[:, into] = (scale * f_z)[:, z_of_u]
-    second[:, into[:, None], into[None, :]] = (f_zz * (scale[:, :, None] * scale[:, None, :]
-                                                       / ell[:, None, None]))[:, z_of_u][:, :, z_of_u]
-    # terms of dc = c^i - c^{i-1}: the twisting of a changing cross-section, D (1 - nu) dc . Q dc / l,
-    # and the odd strain -tau c' . psi(y): E b [kappa_g tau dc . a / l^2 + tau^2 dc . Psi dc / (2 l^3)]
-    g = modes.plate * (1.0 - modes.poisson_ratio)
-    eb = modes.membrane
-    dc = c_after - c_before
-    qdc, adc, pdc = dc @ modes.Q, dc @ modes.a, dc @ modes.Psi
-    dpd = np.einsum("nj,nj->n", dc, pdc)
-    kg, t = kappa_g, tau
-    l2, l3 = ell**2, ell**3
-    energy += g * np.einsum("nj,nj->n", dc, qdc) / ell + eb * (kg * t * adc / l2 + 0.5 * t * t * dpd / l3)
-    d_dc = (2.0 * g * qdc / ell[:, None] + eb * ((kg * t / l2)[:, None] * modes.a[None, :]
-                                                 + (t * t / l3)[:, None] * pdc))
-    before, after = slice(4, 4 + n), slice(4 + n, 4 + 2 * n)
-    first[:, before] -= d_dc
-    first[:, after] += d_dc
-    first[:, 2] += eb * t * adc / l2
-    first[:, 3] += eb * (kg * adc / l2 + t * dpd / l3)
-    second[:, 2, 3] += eb * adc / l2
-    second[:, 3, 2] += eb * adc / l2
-    second[:, 3, 3] += eb * dpd / l3
-    g_dc = eb * (t / l2)[:, None] * modes.a[None, :]                      # d2 / dkappa_g d(dc)
-    t_dc = eb * ((kg / l2)[:, None] * modes.a[None, :] + 2.0 * (t / l3)[:, None] * pdc)  # d2 / dtau d(dc)
-    for block, sign in ((before, -1.0), (after, 1.0)):
-        second[:, 2, block] += sign * g_dc
-        second[:, block, 2] += sign * g_dc
-        second[:, 3, block] += sign * t_dc
-        second[:, block, 3] += sign * t_dc
-    dcdc = 2.0 * g * modes.Q[None, :, :] / ell[:, None, None] + eb * (t * t / l3)[:, None, None] * modes.Psi[None]
-    second[:, before, before] += dcdc
-    second[:, after, after] += dcdc
-    second[:, before, after] -= dcdc
-    second[:, after, before] -= dcdc
+    energy, first, second = np.empty(count), np.empty((count, size)), np.empty((count, size, size))
+    _field_kernel(*arrays, modes.m, modes.S, modes.P, modes.p, modes.Q, modes.a, modes.Psi, modes.membrane,
+                  modes.plate, modes.poisson_ratio, modes.width, modes.constant_hessian, energy, first, second)
     return energy, first, second
 
 

@@ -334,3 +334,134 @@ def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, 
             for b in range(a + 1):
                 band[(place[a] - place[b]) * n_dof + base + place[b]] += h11[a, b]
 
+
+
+@njit(cache=True)
+def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, node_stride, unit_place, n_dof, grad,
+                                band, want_hessian, tau_gradients):
+    """add_stencil_terms for a density e(eps, kappa_n, kappa_g, tau, u_1 .. u_k) per stencil: eps
+    the stencil's Voronoi mean stretch (|e| + |f|) / (|e-bar| + |f-bar|) - 1 (Eq. 2's edges, as
+    ddg.energies.stencil_coupling.stencil_stretch), whose edge form is d eps / de = t_e / R,
+    d2 eps / de2 = (I - t_e t_e^T) / (|e| R) (likewise f; R = |e-bar| + |f-bar|), and u_j DOFs
+    of the stencil's block themselves, at block positions unit_place (the cross-section model's
+    modes, ddg.models.wide_ribbons.CrossSectionRibbon). first (n, 4 + k), second (n, 4 + k, 4 + k)
+    in that order. The first-order parts of all four strains are contracted in edge form before
+    the stencil's 11 x 11 block is formed (one pass, as add_stencil_terms). tau_gradients (n, 11):
+    filled with each stencil's twist gradient over its rod DOFs (for terms coupling neighbouring
+    stencils' twists, `add_twist_pair_terms`), when it has n rows."""
+    strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w = _scratch()
+    g = np.empty((4, STENCIL_SIZE))
+    h11 = np.empty((STENCIL_SIZE, STENCIL_SIZE))
+    ee = np.empty((3, 3))
+    ef = np.empty((3, 3))
+    ff = np.empty((3, 3))
+    eth = np.empty((3, 2))
+    fth = np.empty((3, 2))
+    thth = np.empty(2)
+    te = np.empty(3)
+    tf = np.empty(3)
+    mixed = np.empty(STENCIL_SIZE)
+    place = stencil_place(STENCIL_SIZE, node_stride)
+    units = unit_place.shape[0]
+    keep_tau = tau_gradients.shape[0] == x.shape[0] - 2
+    for i in range(x.shape[0] - 2):
+        _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1],
+                 strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w)
+        ne, nf = 0.0, 0.0
+        for k in range(3):
+            te[k] = x[i + 1, k] - x[i, k]
+            tf[k] = x[i + 2, k] - x[i + 1, k]
+            ne += te[k] * te[k]
+            nf += tf[k] * tf[k]
+        ne, nf = math.sqrt(ne), math.sqrt(nf)
+        rest = rest_edge_lengths[i] + rest_edge_lengths[i + 1]
+        for k in range(3):
+            te[k] /= ne
+            tf[k] /= nf
+            g[0, k] = -te[k] / rest
+            g[0, 4 + k] = (te[k] - tf[k]) / rest
+            g[0, 8 + k] = tf[k] / rest
+        g[0, 3] = 0.0
+        g[0, 7] = 0.0
+        for c in range(3):
+            _stencil_gradient(ge, gf, gth, c, g[1 + c])
+        if keep_tau:
+            for a in range(STENCIL_SIZE):
+                tau_gradients[i, a] = g[3, a]
+        base = node_stride * i
+        for a in range(STENCIL_SIZE):
+            grad[base + place[a]] += (first[i, 0] * g[0, a] + first[i, 1] * g[1, a] + first[i, 2] * g[2, a]
+                                      + first[i, 3] * g[3, a])
+        for j in range(units):
+            grad[base + unit_place[j]] += first[i, 4 + j]
+        if not want_hessian:
+            continue
+        w0, w1, w2, w3 = first[i, 0], first[i, 1], first[i, 2], first[i, 3]
+        se, sf = w0 / (ne * rest), w0 / (nf * rest)
+        for a in range(3):
+            for b in range(3):
+                eye = 1.0 if a == b else 0.0
+                ee[a, b] = w1 * hee[0, a, b] + w2 * hee[1, a, b] + w3 * hee[2, a, b] + se * (eye - te[a] * te[b])
+                ef[a, b] = w1 * hef[0, a, b] + w2 * hef[1, a, b] + w3 * hef[2, a, b]
+                ff[a, b] = w1 * hff[0, a, b] + w2 * hff[1, a, b] + w3 * hff[2, a, b] + sf * (eye - tf[a] * tf[b])
+            for j in range(2):
+                eth[a, j] = w1 * heth[0, a, j] + w2 * heth[1, a, j] + w3 * heth[2, a, j]
+                fth[a, j] = w1 * hfth[0, a, j] + w2 * hfth[1, a, j] + w3 * hfth[2, a, j]
+        for j in range(2):
+            thth[j] = w1 * hthth[0, j] + w2 * hthth[1, j] + w3 * hthth[2, j]
+        _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, h11)
+        for c in range(4):
+            for d in range(4):
+                coefficient = second[i, c, d]
+                if coefficient != 0.0:
+                    for a in range(STENCIL_SIZE):
+                        ga = coefficient * g[c, a]
+                        for b in range(a + 1):
+                            h11[a, b] += ga * g[d, b]
+        for a in range(STENCIL_SIZE):
+            for b in range(a + 1):
+                band[(place[a] - place[b]) * n_dof + base + place[b]] += h11[a, b]
+        # the strains against the unit strains, and the unit strains among themselves
+        for j in range(units):
+            rj = unit_place[j]
+            for a in range(STENCIL_SIZE):
+                mixed[a] = (second[i, 0, 4 + j] * g[0, a] + second[i, 1, 4 + j] * g[1, a]
+                            + second[i, 2, 4 + j] * g[2, a] + second[i, 3, 4 + j] * g[3, a])
+                ra = place[a]
+                if ra >= rj:
+                    band[(ra - rj) * n_dof + base + rj] += mixed[a]
+                else:
+                    band[(rj - ra) * n_dof + base + ra] += mixed[a]
+            for k in range(j + 1):
+                rk = unit_place[k]
+                value = second[i, 4 + j, 4 + k]
+                if rj >= rk:
+                    band[(rj - rk) * n_dof + base + rk] += value
+                else:
+                    band[(rk - rj) * n_dof + base + rj] += value
+
+
+@njit(cache=True)
+def add_twist_pair_terms(tau_gradients, coupling, node_stride, n_dof, band):
+    """The cross terms of an energy of neighbouring stencils' twists, sum_i E(tau_i, tau_{i+1}):
+    adds coupling[i] (g_i g_{i+1}^T + g_{i+1} g_i^T) to the lower band, g_i stencil i's twist
+    gradient (tau_gradients (n, 11), from add_stretched_stencil_terms) and coupling (n - 1,) the
+    mixed partials d2E / dtau_i dtau_{i+1}. The other parts of the chain rule (the first partials
+    and d2E / dtau_i^2) are per stencil and belong in add_stretched_stencil_terms' first/second."""
+    place = stencil_place(STENCIL_SIZE, node_stride)
+    for i in range(tau_gradients.shape[0] - 1):
+        s = coupling[i]
+        if s == 0.0:
+            continue
+        lo, hi = node_stride * i, node_stride * (i + 1)  # stencil i + 1 starts one node later
+        for a in range(STENCIL_SIZE):
+            ra = hi + place[a]
+            for b in range(STENCIL_SIZE):
+                rb = lo + place[b]
+                value = s * tau_gradients[i + 1, a] * tau_gradients[i, b]
+                if ra == rb:   # a DOF of both stencils: both products land on the diagonal
+                    band[rb] += 2.0 * value
+                elif ra > rb:
+                    band[(ra - rb) * n_dof + rb] += value
+                else:
+                    band[(rb - ra) * n_dof + ra] += value

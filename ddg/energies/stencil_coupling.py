@@ -48,14 +48,21 @@ def add_local_terms(bases, grads, hessians, first, second, n_dof, grad, band, wa
                      np.empty(0, dtype=np.int64), first, second, n_dof, grad, band, want_hessian)
 
 
+def stencil_stretch_values(x: np.ndarray, rest_edge_lengths: np.ndarray) -> np.ndarray:
+    """The centreline stretch at the interior nodes, eps_i = (|e| + |f|) / (|e-bar| + |f-bar|) - 1 (n,)."""
+    lengths = np.linalg.norm(x[1:] - x[:-1], axis=1)
+    return (lengths[:-1] + lengths[1:]) / (rest_edge_lengths[:-1] + rest_edge_lengths[1:]) - 1.0
+
+
 def stencil_stretch(x: np.ndarray, rest_edge_lengths: np.ndarray):
     """The centreline stretch at the interior nodes, eps_i = (|e| + |f|) / (|e-bar| + |f-bar|) - 1
-    (n,), its gradient (n, 11) and Hessian (n, 11, 11) over the stencil's DOFs (theta entries 0)."""
+    (n,), its gradient (n, 11) and Hessian (n, 11, 11) over the stencil's DOFs (theta entries 0)
+    (compiled in rod_curvature.add_stretched_stencil_terms, its edge form)."""
     e = x[1:] - x[:-1]
     lengths = np.linalg.norm(e, axis=1)
     t = e / lengths[:, None]
     rest = rest_edge_lengths[:-1] + rest_edge_lengths[1:]
-    eps = (lengths[:-1] + lengths[1:]) / rest - 1.0
+    eps = stencil_stretch_values(x, rest_edge_lengths)
     n = len(eps)
     grads = np.zeros((n, STENCIL_SIZE))
     grads[:, 0:3] = -t[:-1] / rest[:, None]

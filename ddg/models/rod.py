@@ -156,11 +156,19 @@ class RodModel(BandedModel):
         grad, band = self._accumulators(gradient, hessian)
         stretching = add_edge_terms(x, self._edge_nodes, self.rest_edge_lengths, self.stretch_stiffness,
                                     self.node_stride, n, grad, band, gradient, hessian)
-        if gradient:
-            add_stencil_terms(x, m1, m2, first, second, self.node_stride, n, grad, band, hessian)
-        parts.update(self.coupled_terms(q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian))
+        if self.fuses_stencil_terms:
+            parts.update(self.fused_terms(q, x, m1, m2, kappa_n, kappa_g, tau, first, second, grad, band, gradient,
+                                          hessian))
+        else:
+            if gradient:
+                add_stencil_terms(x, m1, m2, first, second, self.node_stride, n, grad, band, hessian)
+            parts.update(self.coupled_terms(q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian))
         return self._evaluation({"stretching": float(stretching), **parts}, grad, band, gradient, hessian,
                                 frames=(t, d1, m_ref))
+
+    #: A model whose energies beyond the rod's share the stencils' chain rule with the rod's own
+    #: (`fused_terms` instead of add_stencil_terms and `coupled_terms`: one pass over the stencils).
+    fuses_stencil_terms = False
 
     def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient: bool, hessian: bool) -> dict:
         """Energies beyond the per-stencil densities (the ribbons with width: the trapeze term's

@@ -32,10 +32,10 @@ import numpy as np
 
 from ..energies.cross_section import (CrossSectionModes, field_density, modes_curvature_form, torsion_warping,
                                       torsion_warping_stiffness)
-from ..energies.rod_curvature import material_curvatures, stencil_place
+from ..energies.rod_curvature import add_stretched_stencil_terms, add_twist_pair_terms, material_curvatures
 from ..energies.sadowsky import check_zeta
-from ..energies.stencil_coupling import (add_local_terms, add_placed_terms, pair_blocks, stencil_strain_blocks,
-                                         stencil_stretch)
+from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_strain_blocks, stencil_stretch,
+                                         stencil_stretch_values)
 from ..energies.trapeze import trapeze_coefficients, trapeze_density
 from ..energies.wunderlich import POLE, wunderlich_pair_density
 from ..geometry.strip import Strip
@@ -117,50 +117,52 @@ class CrossSectionRibbon(RodModel):
         self.modes = CrossSectionModes(strip.width, strip.thickness, strip.young_modulus, strip.poisson_ratio,
                                        self.edge_fields)
         stride = self.node_stride
-        # where the stencil's rod strains (over the rod's 11 DOFs) and its edges' modes sit in its block
-        self._rod_place = stencil_place(11, stride)
+        # where the stencil's edges' modes sit in its block (after each edge's twist angle)
         n = self.edge_fields
         self._mode_place = np.r_[4 + np.arange(n), stride + 4 + np.arange(n)]
         # Eq. V: the torsion-warping of the cross-section, over pairs of stencils (3 stride + 3 DOFs)
         self.warping_stiffness = torsion_warping_stiffness(self.modes)
         self.pair_lengths = self.rest_edge_lengths[1:-1]
-        self._pair_place = stencil_place(15, stride)
         self.bandwidth = 3 * stride + 2  # a pair of stencils spans x_{i-1} .. x_{i+2}: 3 stride + 3 DOFs
         # the modes' bending along the strip, a constant quadratic form in the DOFs (Eq. X')
         rows, cols, values = modes_curvature_form(self.field_dofs, self.centerline.spacing, self.modes)
         self._curvature_band = ((rows - cols) * self.n_dof + cols, values)  # distinct entries of the band
         self._curvature_matrix = _symmetric_csr(rows, cols, values, self.n_dof)
 
-    def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
+    fuses_stencil_terms = True
+
+    def fused_terms(self, q, x, m1, m2, kappa_n, kappa_g, tau, first, second, grad, band, gradient, hessian):
+        """The rod's stencil densities (first, second: partials in (kappa_n, kappa_g, tau)), Eq. X
+        and Eq. V in one compiled pass over the stencils (rod_curvature.add_stretched_stencil_terms),
+        Eq. V's coupling of neighbouring twists in a second (add_twist_pair_terms); Eq. X' is a
+        constant quadratic form."""
         c = q[self.field_dofs]
-        eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
-        _, kappa_g = material_curvatures(x, m1, m2)
-        energy, first, second = field_density(eps, kappa_n, kappa_g, tau, c[:-1], c[1:], self.voronoi_lengths,
-                                              self.modes)
-        if gradient:
-            grads, hessians = stencil_strain_blocks(x, m1, m2)
-            strain_grads = np.concatenate([eps_grad[:, None], grads], axis=1)
-            strain_hess = np.concatenate([eps_hess[:, None], hessians], axis=1)
-            add_placed_terms(self.node_stride * np.arange(len(eps)), self._rod_place, strain_grads, strain_hess,
-                             self._mode_place, first, second, self.n_dof, grad, band, hessian)
+        eps = stencil_stretch_values(x, self.rest_edge_lengths)
+        energy, f_u, f_uu = field_density(eps, kappa_n, kappa_g, tau, c[:-1], c[1:], self.voronoi_lengths,
+                                          self.modes)
         pairs, pair_first, pair_second, ends, end_first, end_second = torsion_warping(
             tau, self.voronoi_lengths, self.pair_lengths, self.warping_stiffness)
-        if gradient:
-            none = np.empty(0, dtype=np.int64)
-            pg, ph = pair_blocks(grads, hessians, (_TAU,))
-            add_placed_terms(self.node_stride * np.arange(len(pairs)), self._pair_place, pg, ph, none,
-                             pair_first, pair_second, self.n_dof, grad, band, hessian)
-            last = len(eps) - 1
-            add_placed_terms(self.node_stride * np.array([0, last]), self._rod_place,
-                             np.ascontiguousarray(grads[[0, last]][:, [_TAU]]),
-                             np.ascontiguousarray(hessians[[0, last]][:, [_TAU]]), none,
-                             end_first[:, None], end_second[:, None, None], self.n_dof, grad, band, hessian)
         curvature_force = self._curvature_matrix @ q
         if gradient:
-            grad += curvature_force
+            # u = (eps, kappa_n, kappa_g, tau, modes): the rod's own partials and Eq. V's per-twist parts join Eq. X's
+            f_u[:, 1:4] += first
+            f_uu[:, 1:4, 1:4] += second
+            last = len(tau) - 1
+            f_u[:-1, 3] += pair_first[:, 0]
+            f_u[1:, 3] += pair_first[:, 1]
+            f_u[[0, last], 3] += end_first
+            f_uu[:-1, 3, 3] += pair_second[:, 0, 0]
+            f_uu[1:, 3, 3] += pair_second[:, 1, 1]
+            f_uu[[0, last], 3, 3] += end_second
+            tau_gradients = np.empty((len(tau), 11)) if hessian else np.empty((0, 11))
+            add_stretched_stencil_terms(x, m1, m2, self.rest_edge_lengths, f_u, f_uu, self.node_stride,
+                                        self._mode_place, self.n_dof, grad, band, hessian, tau_gradients)
             if hessian:
+                add_twist_pair_terms(tau_gradients, np.ascontiguousarray(pair_second[:, 0, 1]), self.node_stride,
+                                     self.n_dof, band)
                 where, values = self._curvature_band
                 band[where] += values
+            grad += curvature_force
         return {"cross_section": float(energy.sum()), "torsion_warping": float(pairs.sum() + ends.sum()),
                 "cross_section_bending": 0.5 * float(q @ curvature_force)}
 
@@ -171,6 +173,43 @@ class CrossSectionRibbon(RodModel):
         3-5e-5 against the rod's floor 9.3e-6, so Newton stalled before the pitchfork."""
         ratio = (self.strip.width / self.centerline.spacing) ** 2 / 25.0
         return super().residual_floor() * max(1.0, ratio)
+
+    def resolution_indicators(self, q: np.ndarray) -> dict:
+        """The rod's indicators plus W max |d kappa_n / ds| / max |kappa_n| (curvature_change_per_width):
+        the largest change of the centreline's normal curvature within one width, relative to its
+        largest value; above LONG_WAVELENGTH_LIMIT the model's expansion does not hold."""
+        out = super().resolution_indicators(q)
+        out["curvature_change_per_width"] = self._curvature_change(q)[0]
+        return out
+
+    def _curvature_change(self, q: np.ndarray) -> tuple[float, float]:
+        """(W max |kappa_n'| / max |kappa_n|, s where kappa_n' is largest), kappa_n per unit length
+        at the interior nodes and kappa_n' its difference between neighbours over their distance."""
+        _, _, m1, m2, _ = self.frames(q)
+        kappa = material_curvatures(q[self.node_dofs], m1, m2)[0] / self.voronoi_lengths
+        largest = float(np.max(np.abs(kappa), initial=0.0))
+        if largest == 0.0 or len(kappa) < 2:
+            return 0.0, 0.0
+        rate = np.abs(np.diff(kappa)) / self.pair_lengths
+        worst = int(np.argmax(rate))
+        where = 0.5 * (self.centerline.node_arclength[worst + 1] + self.centerline.node_arclength[worst + 2])
+        return float(self.strip.width * rate[worst] / largest), float(where)
+
+    def stop_note(self, q: np.ndarray) -> str | None:
+        """Why a stopped path may have stopped: the last converged state's normal curvature changes
+        by more than LONG_WAVELENGTH_LIMIT times its largest value within one width (measured: near
+        dW_max an inflection of the twisted strip squeezed against a clamp, over one to three
+        elements), where a fold the continuation finds may be the 1D expansion's, not the strip's;
+        None otherwise."""
+        change, where = self._curvature_change(q)
+        if change <= LONG_WAVELENGTH_LIMIT:
+            return None
+        s, width = self.strip, self.strip.width
+        from_clamp = min(where, s.length - where) / width
+        return (f"at the last converged state the centreline's normal curvature changes by {change:.2g} times its "
+                f"largest value within one width W, {from_clamp:.2g} W from a clamp (s/L = {where / s.length:.3f}): "
+                f"beyond the long-wavelength expansion of this model (limit {LONG_WAVELENGTH_LIMIT:g}), so the fold "
+                "where the path stopped may be the model's, not the strip's; a plate model resolves it")
 
     def cross_section(self, q: np.ndarray) -> np.ndarray:
         """The modes c^e (M - 1, n) of each edge's cross-section (c_1: transverse curvature, 1/m)."""
@@ -262,6 +301,13 @@ class WunderlichRibbon(RibbonModel):
                 f"at 2 (Eq. A.2): the fold where the path stopped may be that log barrier, not a limit point of the "
                 f"ribbon (zeta = {self.zeta / self.strip.length:.3g} L regularises eta)")
 
+
+#: A model with a width along its centreline (CrossSectionRibbon) expands
+#: the plate in strains that vary over lengths longer than the width W. Where the centreline's
+#: normal curvature changes by more than this multiple of its largest value within one width
+#: (W |d kappa_n / ds| / max |kappa_n| above 1: for a sinusoid, a wavelength below 2 pi W) the
+#: expansion does not hold (path column `curvature_change_per_width`; ddg.protocol.validity).
+LONG_WAVELENGTH_LIMIT = 1.0
 
 #: A stopped Wunderlich path whose largest |W eta'| is above NEAR_POLE * 2 is said to stop at the barrier.
 NEAR_POLE = 0.9

@@ -14,7 +14,9 @@ a ValidityWarning):
   narrower than the map's narrowest strip is not flagged. Without a map file, no width check.
 * Mesh: the recorded path went past the last state the discretisation resolves (neighbouring
   elements turning by more than RESOLVED_TURN_ANGLE_DEG, or a strain above RESOLVED_STRAIN;
-  ddg.analysis.observables), with the shear where it happened.
+  ddg.analysis.observables), with the shear where it happened; for the 1D model with its
+  cross-section, past the last state its long-wavelength expansion holds (the path column
+  curvature_change_per_width above LONG_WAVELENGTH_LIMIT, ddg.models.wide_ribbons).
 * Thresholds: dW1 or dW2 null although the path went to its end (and the thresholds were
   sought), with why (the phases the path passed, the folds it met), unless the threshold was
   already reported unresolved.
@@ -24,6 +26,7 @@ from __future__ import annotations
 import warnings
 
 from ..analysis.observables import RESOLVED_STRAIN, RESOLVED_TURN_ANGLE_DEG
+from ..models.wide_ribbons import LONG_WAVELENGTH_LIMIT
 
 #: dW1/L error + reference error bar (units of L) above which the map does not show a 1D model good enough.
 WIDTH_TOLERANCE = 0.01
@@ -75,6 +78,13 @@ def mesh_warnings(summary: dict, rows: list[dict]) -> list[str]:
                    f"(neighbouring elements turn by {turned['max_turn_angle_deg']:.0f} deg > "
                    f"{RESOLVED_TURN_ANGLE_DEG:.0f}, up to {worst:.0f} deg by dW/L = {shear[-1]['dW_over_L']:.4f}): "
                    f"only {upto} is resolved (resolved_up_to_dW_over_L); refine the mesh for the rest")
+    varied = next((r for r in shear if (r.get("curvature_change_per_width") or 0.0) > LONG_WAVELENGTH_LIMIT), None)
+    if varied is not None:
+        worst = max((r.get("curvature_change_per_width") or 0.0) for r in shear)
+        out.append(f"the {model}'s long-wavelength expansion fails from dW/L = {varied['dW_over_L']:.4f} on: the "
+                   f"centreline's normal curvature changes by {varied['curvature_change_per_width']:.2g} times its "
+                   f"largest value within one width (limit {LONG_WAVELENGTH_LIMIT:g}; up to {worst:.2g} by dW/L = "
+                   f"{shear[-1]['dW_over_L']:.4f}): outside the model's validity there; a plate model resolves it")
     strained = next((r for r in shear if (r.get("max_strain") or 0.0) > RESOLVED_STRAIN), None)
     if strained is not None:
         out.append(f"the {model} stretches by {strained['max_strain']:.3g} > {RESOLVED_STRAIN:g} at dW/L = "

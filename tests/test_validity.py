@@ -118,3 +118,20 @@ def test_mesh_and_threshold_rules_on_recorded_rows():
     assert threshold_warnings({**summary, "path_complete": False}, rows) == []
     # thresholds not sought (--no-thresholds): nothing to say
     assert threshold_warnings({**summary, "threshold_wall_time_s": None}, rows) == []
+
+
+def test_the_cross_section_model_says_where_its_long_wavelength_expansion_ends():
+    """The 1D model with its cross-section expands the plate in strains varying over more than a
+    width: from the first recorded state whose normal curvature changes by more than
+    LONG_WAVELENGTH_LIMIT times its largest value within one width, a warning says so; rows of
+    models without that column never warn."""
+    from ddg.models.wide_ribbons import LONG_WAVELENGTH_LIMIT
+
+    rows = [{"stage": "shear", "dW_over_L": x, "phase": "U", "max_turn_angle_deg": 5.0, "max_strain": 1e-4,
+             "curvature_change_per_width": v} for x, v in ((0.1, 0.3), (0.2, 0.9), (0.3, 1.6), (0.4, 5.5))]
+    summary = {"model": "ribbon-cross-section", "resolved_up_to_dW_over_L": 0.4}
+    (text,) = mesh_warnings(summary, rows)
+    assert "long-wavelength expansion at dW/L = 0.3000" in text and "1.6 times" in text and "up to 5.5" in text
+    assert f"limit {LONG_WAVELENGTH_LIMIT:g}" in text
+    assert mesh_warnings(summary, [{k: v for k, v in r.items() if k != "curvature_change_per_width"}
+                                   for r in rows]) == []

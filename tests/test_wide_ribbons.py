@@ -281,3 +281,34 @@ def test_a_wunderlich_path_stopped_at_the_barrier_is_reported_so():
     assert result.summary["status"] == "stopped"
     assert "log barrier" in result.summary["message"]
     assert any("pole of Wunderlich's ruling factor" in w for w in result.summary["warnings"])
+
+
+def test_cross_section_curvature_change_per_width_of_a_sinusoid():
+    """curvature_change_per_width = W max |kappa_n'| / max |kappa_n|: on a planar centreline bent as
+    kappa_n(s) = K sin(2 pi s / lambda) it is 2 pi W / lambda (to the discretisation's O(h^2)), and
+    the stop note quotes it only above LONG_WAVELENGTH_LIMIT."""
+    from ddg.models.wide_ribbons import CrossSectionRibbon
+
+    strip = ddg.Strip.from_ratios(1 / 12, 0.5)
+    nodes = 401
+    model = CrossSectionRibbon(strip, nodes)
+    length = strip.length
+    for wavelength, expect_note in ((length, False), (length / 8, True)):
+        s = np.linspace(0.0, length, nodes)
+        curvature = 5.0 / length   # kappa_n = K sin(2 pi s / lambda): the tangent's angle is its integral
+        angle = -curvature * wavelength / (2 * np.pi) * np.cos(2 * np.pi * s / wavelength)
+        h = s[1] - s[0]
+        edge_angle = 0.5 * (angle[1:] + angle[:-1])
+        x = np.zeros((nodes, 3))
+        x[1:, 0] = np.cumsum(h * np.cos(edge_angle))
+        x[1:, 2] = np.cumsum(h * np.sin(edge_angle))
+        q = np.zeros(model.n_dof)
+        q[model.node_dofs] = x
+        model.commit(q, model.evaluate(q))
+        indicators = model.resolution_indicators(q)
+        expected = 2 * np.pi * strip.width / wavelength
+        assert indicators["curvature_change_per_width"] == pytest.approx(expected, rel=0.02)
+        note = model.stop_note(q)
+        assert (note is not None) == expect_note
+        if expect_note:
+            assert f"{indicators['curvature_change_per_width']:.2g} times" in note

@@ -15,7 +15,7 @@ from ..solve.state import phase_label
 
 PATH_COLUMNS = ("stage", "dL_over_L", "dW_over_L", "H_mid_over_L", "F_shear_norm", "energy", "lambda_min", "phase")
 EXTRA_COLUMNS = ("F_axial_norm", "stable", "newton_iterations", "branch_switched", "max_turn_angle_deg",
-                 "max_strain", "negative_eigenvalues", "stretching_share")
+                 "max_strain", "negative_eigenvalues", "stretching_share", "curvature_change_per_width")
 
 #: Beyond this angle between neighbouring elements (edges of the rod, triangles of the plate) the
 #: discretisation no longer resolves the shape (e.g. the conical singularities that form at the

@@ -35,19 +35,6 @@ from .rod_curvature import STENCIL_SIZE, strain_derivatives
 PAIR_SIZE = STENCIL_SIZE + 4
 
 
-def add_local_terms(bases, grads, hessians, first, second, n_dof, grad, band, want_hessian):
-    """Adds sum_p E_p to grad and (want_hessian) to the lower band of an n_dof matrix.
-
-    bases (P,): first DOF of each term's contiguous block; grads (P, k, D) and hessians
-    (P, k, D, D): each strain's derivatives over the block; first (P, k) = de_p / ds_a and second
-    (P, k, k) = d2e_p / ds_a ds_b. band is LAPACK's lower band form flattened: entry (r, c), r >= c,
-    at band[(r - c) * n_dof + c]; the blocks must fit the band (D - 1 <= bandwidth). The kernel is
-    add_placed_terms with the block's DOFs in order and no strain that is a DOF itself."""
-    size = grads.shape[2]
-    add_placed_terms(np.asarray(bases, dtype=np.int64), np.arange(size, dtype=np.int64), grads, hessians,
-                     np.empty(0, dtype=np.int64), first, second, n_dof, grad, band, want_hessian)
-
-
 def stencil_stretch_values(x: np.ndarray, rest_edge_lengths: np.ndarray) -> np.ndarray:
     """The centreline stretch at the interior nodes, eps_i = (|e| + |f|) / (|e-bar| + |f-bar|) - 1 (n,)."""
     lengths = np.linalg.norm(x[1:] - x[:-1], axis=1)
@@ -105,20 +92,15 @@ def pair_blocks(grads: np.ndarray, hessians: np.ndarray, components: tuple[int, 
 
 
 @njit(cache=True)
-def add_placed_terms(bases, place, grads, hessians, unit_place, first, second, n_dof, grad, band, want_hessian):
-    """The chain rule of add_local_terms for terms whose first h strains have derivatives over D DOFs
-    of the block and whose other u strains are DOFs themselves (a model with more DOFs per edge: the
-    cross-section's modes, ddg.models.wide_ribbons.CrossSectionRibbon).
+def add_local_terms(bases, grads, hessians, first, second, n_dof, grad, band, want_hessian):
+    """Adds sum_p E_p to grad and (want_hessian) to the lower band of an n_dof matrix.
 
-    bases (P,): first DOF of each term's block; place (D,): where those D DOFs sit in the block
-    (the rod's 11 stencil DOFs among the cross-section model's 2 node_stride + 3); grads (P, h, D)
-    and hessians (P, h, D, D): the h strains' derivatives; unit_place (u,): where the other strains
-    sit in the block (each is one DOF: unit gradient, no Hessian); first (P, h + u) and second
-    (P, h + u, h + u): the density's partials. Every block position must be increasing with its
-    index in place (the band takes r >= c). The Hessian's D x D part is sum_c first_c H_c +
-    sum_d (sum_c second_cd g_c) g_d^T, O(h D^2) per term."""
+    bases (P,) int: first DOF of each term's contiguous block; grads (P, k, D) and hessians
+    (P, k, D, D): each strain's derivatives over the block; first (P, k) = de_p / ds_a and second
+    (P, k, k) = d2e_p / ds_a ds_b. band is LAPACK's lower band form flattened: entry (r, c), r >= c,
+    at band[(r - c) * n_dof + c]; the blocks must fit the band (D - 1 <= bandwidth). The Hessian is
+    sum_c first_c H_c + sum_d (sum_c second_cd g_c) g_d^T, O(k D^2) per term."""
     n_terms, h, size = grads.shape
-    u = unit_place.shape[0]
     mixed = np.empty((h, size))
     for p in range(n_terms):
         base = bases[p]
@@ -126,12 +108,9 @@ def add_placed_terms(bases, place, grads, hessians, unit_place, first, second, n
             total = 0.0
             for c in range(h):
                 total += first[p, c] * grads[p, c, a]
-            grad[base + place[a]] += total
-        for j in range(u):
-            grad[base + unit_place[j]] += first[p, h + j]
+            grad[base + a] += total
         if not want_hessian:
             continue
-        # rod x rod: sum_c first_c H_c + sum_cd second_cd g_c g_d^T, via mixed_d = sum_c second_cd g_c
         for d in range(h):
             for a in range(size):
                 total = 0.0
@@ -139,31 +118,8 @@ def add_placed_terms(bases, place, grads, hessians, unit_place, first, second, n
                     total += second[p, c, d] * grads[p, c, a]
                 mixed[d, a] = total
         for a in range(size):
-            ra = place[a]
-            for b in range(size):
-                rb = place[b]
-                if rb > ra:
-                    continue
+            for b in range(a + 1):
                 total = 0.0
                 for c in range(h):
                     total += first[p, c] * hessians[p, c, a, b] + mixed[c, a] * grads[p, c, b]
-                band[(ra - rb) * n_dof + base + rb] += total
-        # rod x unit and unit x unit
-        for j in range(u):
-            rj = unit_place[j]
-            for a in range(size):
-                total = 0.0
-                for c in range(h):
-                    total += second[p, c, h + j] * grads[p, c, a]
-                ra = place[a]
-                if ra >= rj:
-                    band[(ra - rj) * n_dof + base + rj] += total
-                else:
-                    band[(rj - ra) * n_dof + base + ra] += total
-            for i in range(j + 1):
-                ri = unit_place[i]
-                value = second[p, h + j, h + i]
-                if rj >= ri:
-                    band[(rj - ri) * n_dof + base + ri] += value
-                else:
-                    band[(ri - rj) * n_dof + base + rj] += value
+                band[(a - b) * n_dof + base + b] += total

@@ -81,10 +81,11 @@ def mesh_warnings(summary: dict, rows: list[dict]) -> list[str]:
     varied = next((r for r in shear if (r.get("curvature_change_per_width") or 0.0) > LONG_WAVELENGTH_LIMIT), None)
     if varied is not None:
         worst = max((r.get("curvature_change_per_width") or 0.0) for r in shear)
-        out.append(f"the {model}'s long-wavelength expansion fails from dW/L = {varied['dW_over_L']:.4f} on: the "
-                   f"centreline's normal curvature changes by {varied['curvature_change_per_width']:.2g} times its "
-                   f"largest value within one width (limit {LONG_WAVELENGTH_LIMIT:g}; up to {worst:.2g} by dW/L = "
-                   f"{shear[-1]['dW_over_L']:.4f}): outside the model's validity there; a plate model resolves it")
+        out.append(f"the {model} leaves the range of its long-wavelength expansion at dW/L = "
+                   f"{varied['dW_over_L']:.4f}: the centreline's normal curvature changes by "
+                   f"{varied['curvature_change_per_width']:.2g} times its largest value within one width (limit "
+                   f"{LONG_WAVELENGTH_LIMIT:g}; up to {worst:.2g} by dW/L = {shear[-1]['dW_over_L']:.4f}); the states "
+                   "past it are outside what the model covers; a plate model resolves them")
     strained = next((r for r in shear if (r.get("max_strain") or 0.0) > RESOLVED_STRAIN), None)
     if strained is not None:
         out.append(f"the {model} stretches by {strained['max_strain']:.3g} > {RESOLVED_STRAIN:g} at dW/L = "

@@ -278,6 +278,43 @@ def stencil_place(size, node_stride):
     return place + (place // 4) * (node_stride - 4)
 
 
+@njit(cache=True, inline="always")
+def _weighted_edge_forms(w0, w1, w2, hee, hef, hff, heth, hfth, hthth, ee, ef, ff, eth, fth, thth):
+    """sum_c w_c (edge-form second derivative of strain c), c = kappa_n, kappa_g, tau."""
+    for a in range(3):
+        for b in range(3):
+            ee[a, b] = w0 * hee[0, a, b] + w1 * hee[1, a, b] + w2 * hee[2, a, b]
+            ef[a, b] = w0 * hef[0, a, b] + w1 * hef[1, a, b] + w2 * hef[2, a, b]
+            ff[a, b] = w0 * hff[0, a, b] + w1 * hff[1, a, b] + w2 * hff[2, a, b]
+        for j in range(2):
+            eth[a, j] = w0 * heth[0, a, j] + w1 * heth[1, a, j] + w2 * heth[2, a, j]
+            fth[a, j] = w0 * hfth[0, a, j] + w1 * hfth[1, a, j] + w2 * hfth[2, a, j]
+    for j in range(2):
+        thth[j] = w0 * hthth[0, j] + w1 * hthth[1, j] + w2 * hthth[2, j]
+
+
+@njit(cache=True, inline="always")
+def _add_gradient_products(second, g, count, h11):
+    """h11 += sum_cd second_cd g_c g_d^T over the first `count` strains (lower triangle only)."""
+    for c in range(count):
+        for d in range(count):
+            coefficient = second[c, d]
+            if coefficient != 0.0:
+                for a in range(STENCIL_SIZE):
+                    ga = coefficient * g[c, a]
+                    for b in range(a + 1):
+                        h11[a, b] += ga * g[d, b]
+
+
+@njit(cache=True, inline="always")
+def _scatter_lower(h11, place, base, n_dof, band):
+    """The stencil block's lower triangle into the flattened lower band: its DOFs are increasing in
+    a, so entry (a, b), a >= b, lands at band[(place[a] - place[b]) * n_dof + base + place[b]]."""
+    for a in range(STENCIL_SIZE):
+        for b in range(a + 1):
+            band[(place[a] - place[b]) * n_dof + base + place[b]] += h11[a, b]
+
+
 @njit(cache=True)
 def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, want_hessian):
     """Chain rule for an energy sum_i e(kappa_n, kappa_g, tau) of the stencils: adds its gradient
@@ -307,32 +344,11 @@ def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, 
             grad[base + place[a]] += first[i, 0] * g11[0, a] + first[i, 1] * g11[1, a] + first[i, 2] * g11[2, a]
         if not want_hessian:
             continue
-        w0, w1, w2 = first[i, 0], first[i, 1], first[i, 2]
-        for a in range(3):
-            for b in range(3):
-                ee[a, b] = w0 * hee[0, a, b] + w1 * hee[1, a, b] + w2 * hee[2, a, b]
-                ef[a, b] = w0 * hef[0, a, b] + w1 * hef[1, a, b] + w2 * hef[2, a, b]
-                ff[a, b] = w0 * hff[0, a, b] + w1 * hff[1, a, b] + w2 * hff[2, a, b]
-            for j in range(2):
-                eth[a, j] = w0 * heth[0, a, j] + w1 * heth[1, a, j] + w2 * heth[2, a, j]
-                fth[a, j] = w0 * hfth[0, a, j] + w1 * hfth[1, a, j] + w2 * hfth[2, a, j]
-        for j in range(2):
-            thth[j] = w0 * hthth[0, j] + w1 * hthth[1, j] + w2 * hthth[2, j]
+        _weighted_edge_forms(first[i, 0], first[i, 1], first[i, 2], hee, hef, hff, heth, hfth, hthth,
+                             ee, ef, ff, eth, fth, thth)
         _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, h11)
-        # the stencil's DOFs are increasing in a (contiguous, base .. base + 10, for the rod):
-        # entry (a, b), a >= b, of its Hessian lands at band[(place[a] - place[b]) * n + base +
-        # place[b]]; only the lower triangle is formed
-        for c in range(3):
-            for d in range(3):
-                coefficient = second[i, c, d]
-                if coefficient != 0.0:
-                    for a in range(STENCIL_SIZE):
-                        ga = coefficient * g11[c, a]
-                        for b in range(a + 1):
-                            h11[a, b] += ga * g11[d, b]
-        for a in range(STENCIL_SIZE):
-            for b in range(a + 1):
-                band[(place[a] - place[b]) * n_dof + base + place[b]] += h11[a, b]
+        _add_gradient_products(second[i], g11, 3, h11)
+        _scatter_lower(h11, place, node_stride * i, n_dof, band)
 
 
 
@@ -396,31 +412,17 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
             grad[base + unit_place[j]] += first[i, 4 + j]
         if not want_hessian:
             continue
-        w0, w1, w2, w3 = first[i, 0], first[i, 1], first[i, 2], first[i, 3]
-        se, sf = w0 / (ne * rest), w0 / (nf * rest)
+        _weighted_edge_forms(first[i, 1], first[i, 2], first[i, 3], hee, hef, hff, heth, hfth, hthth,
+                             ee, ef, ff, eth, fth, thth)
+        se, sf = first[i, 0] / (ne * rest), first[i, 0] / (nf * rest)   # the stretch's edge form
         for a in range(3):
             for b in range(3):
                 eye = 1.0 if a == b else 0.0
-                ee[a, b] = w1 * hee[0, a, b] + w2 * hee[1, a, b] + w3 * hee[2, a, b] + se * (eye - te[a] * te[b])
-                ef[a, b] = w1 * hef[0, a, b] + w2 * hef[1, a, b] + w3 * hef[2, a, b]
-                ff[a, b] = w1 * hff[0, a, b] + w2 * hff[1, a, b] + w3 * hff[2, a, b] + sf * (eye - tf[a] * tf[b])
-            for j in range(2):
-                eth[a, j] = w1 * heth[0, a, j] + w2 * heth[1, a, j] + w3 * heth[2, a, j]
-                fth[a, j] = w1 * hfth[0, a, j] + w2 * hfth[1, a, j] + w3 * hfth[2, a, j]
-        for j in range(2):
-            thth[j] = w1 * hthth[0, j] + w2 * hthth[1, j] + w3 * hthth[2, j]
+                ee[a, b] += se * (eye - te[a] * te[b])
+                ff[a, b] += sf * (eye - tf[a] * tf[b])
         _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, h11)
-        for c in range(4):
-            for d in range(4):
-                coefficient = second[i, c, d]
-                if coefficient != 0.0:
-                    for a in range(STENCIL_SIZE):
-                        ga = coefficient * g[c, a]
-                        for b in range(a + 1):
-                            h11[a, b] += ga * g[d, b]
-        for a in range(STENCIL_SIZE):
-            for b in range(a + 1):
-                band[(place[a] - place[b]) * n_dof + base + place[b]] += h11[a, b]
+        _add_gradient_products(second[i], g, 4, h11)
+        _scatter_lower(h11, place, base, n_dof, band)
         # the strains against the unit strains, and the unit strains among themselves
         for j in range(units):
             rj = unit_place[j]

@@ -299,15 +299,15 @@ def _field_kernel(eps, kappa, kappa_g, tau, c_before, c_after, ell, m, s, big_p,
     scale = np.empty(size)
     g = d * (1.0 - nu)
     for i in range(count):
-        l = ell[i]
+        length = ell[i]
         for j in range(n):
             c_mean[j] = 0.5 * (c_before[i, j] + c_after[i, j])
-        f = _point_terms(eps[i], kappa[i] / l, tau[i] / l, c_mean, m, s, big_p, p, eb, d, nu, width, jac, h_g, g_w,
-                         f_z, f_zz)
-        # u -> z = (eps, kappa / l, tau / l, (c^{i-1} + c^i) / 2): E_i = l f
-        scale[0], scale[1], scale[2], scale[3] = l, 1.0, 0.0, 1.0
+        f = _point_terms(eps[i], kappa[i] / length, tau[i] / length, c_mean, m, s, big_p, p, eb, d, nu, width,
+                         jac, h_g, g_w, f_z, f_zz)
+        # u -> z = (eps, kappa / length, tau / length, (c^{i-1} + c^i) / 2): E_i = length f
+        scale[0], scale[1], scale[2], scale[3] = length, 1.0, 0.0, 1.0
         for j in range(2 * n):
-            scale[4 + j] = 0.5 * l
+            scale[4 + j] = 0.5 * length
         fi = first[i]
         se = second[i]
         for r in range(size):
@@ -315,9 +315,9 @@ def _field_kernel(eps, kappa, kappa_g, tau, c_before, c_after, ell, m, s, big_p,
             fi[r] = scale[r] * f_z[zr] if zr >= 0 else 0.0
             for col in range(size):
                 zc = z_of_u[col]
-                se[r, col] = f_zz[zr, zc] * scale[r] * scale[col] / l if zr >= 0 and zc >= 0 else 0.0
-        # terms of dc = c^i - c^{i-1}: the twisting of a changing cross-section, D (1 - nu) dc . Q dc / l,
-        # and the odd strain -tau c' . psi(y): E b [kappa_g tau dc . a / l^2 + tau^2 dc . Psi dc / (2 l^3)]
+                se[r, col] = f_zz[zr, zc] * scale[r] * scale[col] / length if zr >= 0 and zc >= 0 else 0.0
+        # terms of dc = c^i - c^{i-1}: the twisting of a changing cross-section, D (1 - nu) dc . Q dc / length,
+        # and the odd strain -tau c' . psi(y): E b [kappa_g tau dc . a / length^2 + tau^2 dc . Psi dc / (2 length^3)]
         for j in range(n):
             dc[j] = c_after[i, j] - c_before[i, j]
         qq = 0.0
@@ -334,15 +334,15 @@ def _field_kernel(eps, kappa, kappa_g, tau, c_before, c_after, ell, m, s, big_p,
             adc += a[j] * dc[j]
             dpd += dc[j] * pj
         kg, t = kappa_g[i], tau[i]
-        l2, l3 = l * l, l * l * l
-        energy[i] = l * f + g * qq / l + eb * (kg * t * adc / l2 + 0.5 * t * t * dpd / l3)
+        l2, l3 = length * length, length * length * length
+        energy[i] = length * f + g * qq / length + eb * (kg * t * adc / l2 + 0.5 * t * t * dpd / l3)
         fi[2] += eb * t * adc / l2
         fi[3] += eb * (kg * adc / l2 + t * dpd / l3)
         se[2, 3] += eb * adc / l2
         se[3, 2] += eb * adc / l2
         se[3, 3] += eb * dpd / l3
         for j in range(n):
-            d_dc = 2.0 * g * qdc[j] / l + eb * (kg * t / l2 * a[j] + t * t / l3 * pdc[j])
+            d_dc = 2.0 * g * qdc[j] / length + eb * (kg * t / l2 * a[j] + t * t / l3 * pdc[j])
             g_dc = eb * t / l2 * a[j]                                   # d2 / dkappa_g d(dc)
             t_dc = eb * (kg / l2 * a[j] + 2.0 * t / l3 * pdc[j])        # d2 / dtau d(dc)
             for block, sign in ((4, -1.0), (4 + n, 1.0)):
@@ -352,7 +352,7 @@ def _field_kernel(eps, kappa, kappa_g, tau, c_before, c_after, ell, m, s, big_p,
                 se[3, block + j] += sign * t_dc
                 se[block + j, 3] += sign * t_dc
             for r in range(n):
-                dcdc = 2.0 * g * q[j, r] / l + eb * t * t / l3 * big_psi[j, r]
+                dcdc = 2.0 * g * q[j, r] / length + eb * t * t / l3 * big_psi[j, r]
                 se[4 + j, 4 + r] += dcdc
                 se[4 + n + j, 4 + n + r] += dcdc
                 se[4 + j, 4 + n + r] -= dcdc

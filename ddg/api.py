@@ -21,6 +21,8 @@ from .protocol.driver import AfterStep, Loading, Run, execute
 from .protocol.progress import ProgressBar
 from .protocol.results import DynamicResult, RibbonResult, SimulationResult, base_summary
 from .protocol.steppers import ImplicitEulerStepper, RodDrivenStepper, StaticStepper, dynamic_loading
+from .solve.blas_threads import describe as describe_blas_threads
+from .solve.blas_threads import requested_threads as requested_blas_threads
 from .solve.continuation import ContinuationOptions
 from .solve.probe import SILENT, Probe
 
@@ -154,7 +156,10 @@ MAX_TRIANGLES = 1_000_000
 
 
 def _open_folder(out, summary: dict):
-    """The RunFolder of `out` (None if out is None), marked in progress with this summary."""
+    """The RunFolder of `out` (None if out is None), marked in progress with this summary (which
+    records the run's BLAS threads, ddg.solve.blas_threads: an invalid DDG_BLAS_THREADS is refused
+    here, before any work)."""
+    summary["blas_threads"] = describe_blas_threads()
     if out is None:
         return None
     from .output.io import RunFolder
@@ -274,6 +279,7 @@ def simulate(
     choice outside the map (ddg.advise; simulate_auto), run; summary key `auto` says why.
     """
     _checked_scene(strip, protocol)
+    requested_blas_threads()   # DDG_BLAS_THREADS refused before any work
     if isinstance(model, str) and model == "auto":
         return simulate_auto(strip, protocol, tolerance, quantities, error_map, resolution=resolution, out=out,
                              options=options, progress=progress, solver=solver, dynamic_options=dynamic_options,
@@ -388,6 +394,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
     from .models.ribbon import RibbonModel
     from .models.rod import RodModel
 
+    requested_blas_threads()
     if init not in RIBBON_INITS:
         raise InputError(f"ribbon init = {init!r} is not available; choose one of {list(RIBBON_INITS)}")
     if not isinstance(strip, Strip) or not isinstance(protocol, LoadingProtocol):
@@ -424,6 +431,7 @@ def simulate_dynamic(strip: Strip, protocol: LoadingProtocol, resolution: int = 
     from .solve.dynamics import DynamicOptions
 
     _checked_scene(strip, protocol)
+    requested_blas_threads()   # DDG_BLAS_THREADS refused before any work
     if options is not None and not isinstance(options, DynamicOptions):
         raise InputError(f"options = {options!r} must be a ddg.solve.dynamics.DynamicOptions")
     options = dataclasses.replace(options) if options is not None else DynamicOptions()  # re-validated

@@ -498,6 +498,9 @@ def _main(argv=None) -> int:
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
+        from .solve.blas_threads import requested_threads
+
+        requested_threads()   # a bad DDG_BLAS_THREADS is refused before any command does work
         if args.command == "simulate":
             return cmd_simulate(args)
         if args.command == "curvatures":

@@ -23,6 +23,7 @@ from typing import Callable, Protocol, Sequence
 
 from ..geometry.strip import LoadingProtocol, Strip
 from ..output.interrupts import interrupt_behind
+from ..solve.blas_threads import blas_threads
 from ..solve.probe import SILENT, Probe
 from ..solve.state import BranchOrientation, half_turn_odd_part
 from .validity import add_validity_warnings, raise_warnings
@@ -192,7 +193,13 @@ def _model_stop_note(run: Run, out) -> None:
 
 def execute(run: Run) -> SimulationResult:
     """follow(run), then the steps after the path, the summary, the run's files; returns the
-    result, or re-raises an interrupt or an error after writing what was computed."""
+    result, or re-raises an interrupt or an error after writing what was computed. The whole run
+    has the BLAS threads of ddg.solve.blas_threads (one by default), restored afterwards."""
+    with blas_threads():
+        return _execute(run)
+
+
+def _execute(run: Run) -> SimulationResult:
     t0 = run.started if run.started is not None else time.perf_counter()
     out = follow(run)
     for closer in run.close:

@@ -9,7 +9,7 @@ DDG_BLAS_THREADS=keep (OpenBLAS's own default: as many threads as cores), it run
 path of ddg.simulate(Strip.from_ratios(W/L, 1/2), LoadingProtocol(1/2), model="plate",
 resolution=N, branches=False) in a fresh child process, first on the idle machine, then beside a
 busy neighbour (a child process spinning `while True: pass`, started before and stopped after),
-the best of --repeat of each, and reports the run's wall time (summary wall_time_s), Newton
+the best of --repeat of each (after `python -m ddg warmup`, so no run compiles kernels), and reports the run's wall time (summary wall_time_s), Newton
 iterations, the slowdown busy / idle and the one-minute load average before each run. Writes
 OUT/plate_under_load.json and .md atomically. Not part of the test run.
 """
@@ -66,6 +66,8 @@ def one_run(setting: str, width: float, triangles: int, busy: bool, timeout: flo
 
 
 def measure(width: float, triangles: int, repeat: int, timeout: float) -> list[dict]:
+    # compile (or load) the kernels once, so no measured run pays numba's compilation
+    subprocess.run([sys.executable, "-m", "ddg", "warmup"], capture_output=True, timeout=timeout, check=True)
     rows = []
     for setting in SETTINGS:
         best = {}

@@ -9,9 +9,10 @@ DDG_BLAS_THREADS=keep (OpenBLAS's own default: as many threads as cores), it run
 path of ddg.simulate(Strip.from_ratios(W/L, 1/2), LoadingProtocol(1/2), model="plate",
 resolution=N, branches=False) in a fresh child process, first on the idle machine, then beside a
 busy neighbour (a child process spinning `while True: pass`, started before and stopped after),
-the best of --repeat of each (after `python -m ddg warmup`, so no run compiles kernels), and reports the run's wall time (summary wall_time_s), Newton
-iterations, the slowdown busy / idle and the one-minute load average before each run. Writes
-OUT/plate_under_load.json and .md atomically. Not part of the test run.
+the best of --repeat of each (after `python -m ddg warmup`, so no run compiles kernels), and
+reports the run's wall time (summary wall_time_s), Newton iterations, the slowdown busy / idle
+and the one-minute load average before each run. Writes OUT/plate_under_load.json and .md
+atomically. Not part of the test run.
 """
 from __future__ import annotations
 

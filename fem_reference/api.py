@@ -19,6 +19,8 @@ import numpy as np
 
 from ddg.geometry.strip import InputError, LoadingProtocol, Strip
 from ddg.protocol.results import SimulationResult
+from ddg.solve.blas_threads import describe as describe_blas_threads
+from ddg.solve.blas_threads import requested_threads
 from ddg.output.io import write_centerline_csv, write_path_csv, write_summary_json
 
 from .materials import MATERIALS
@@ -121,6 +123,7 @@ def check_inputs(strip, protocol, resolution, across=None, material: str = "isot
              "element": "element", **(names or {})}
     if not isinstance(strip, Strip) or not isinstance(protocol, LoadingProtocol):
         raise InputError("simulate needs a ddg Strip and a ddg LoadingProtocol")
+    requested_threads()   # DDG_BLAS_THREADS (the run's BLAS threads, ddg.solve.blas_threads)
     spec = checked_spec(resolution, strip.width_ratio, across, names["resolution"], names["across"],
                         element, names["element"])
     if not isinstance(material, str) or material not in MATERIALS:
@@ -207,6 +210,7 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
                            "no step computed")
         raise
     summary["material"] = material
+    summary["blas_threads"] = describe_blas_threads()
     summary["build_wall_time_s"] = time.perf_counter() - t_build
     if folder is not None:
         folder.checkpoint(summary)

@@ -279,6 +279,13 @@ def stencil_place(size, node_stride):
 
 
 @njit(cache=True, inline="always")
+def _contraction_scratch():
+    """Work arrays of the chain rule of one stencil: its 11 x 11 block and the weighted edge forms."""
+    return (np.empty((STENCIL_SIZE, STENCIL_SIZE)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
+            np.empty((3, 2)), np.empty((3, 2)), np.empty(2))
+
+
+@njit(cache=True, inline="always")
 def _weighted_edge_forms(w0, w1, w2, hee, hef, hff, heth, hfth, hthth, ee, ef, ff, eth, fth, thth):
     """sum_c w_c (edge-form second derivative of strain c), c = kappa_n, kappa_g, tau."""
     for a in range(3):
@@ -326,13 +333,7 @@ def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, 
     puts them after the angle), so stencil i starts at DOF node_stride * i."""
     strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w = _scratch()
     g11 = np.empty((3, STENCIL_SIZE))
-    h11 = np.empty((STENCIL_SIZE, STENCIL_SIZE))
-    ee = np.empty((3, 3))
-    ef = np.empty((3, 3))
-    ff = np.empty((3, 3))
-    eth = np.empty((3, 2))
-    fth = np.empty((3, 2))
-    thth = np.empty(2)
+    h11, ee, ef, ff, eth, fth, thth = _contraction_scratch()
     place = stencil_place(STENCIL_SIZE, node_stride)  # the stencil's 11 DOFs within its block
     for i in range(x.shape[0] - 2):
         _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1],
@@ -367,13 +368,7 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
     stencils' twists, `add_twist_pair_terms`), when it has n rows."""
     strain, ge, gf, gth, hee, hef, hff, heth, hfth, hthth, w = _scratch()
     g = np.empty((4, STENCIL_SIZE))
-    h11 = np.empty((STENCIL_SIZE, STENCIL_SIZE))
-    ee = np.empty((3, 3))
-    ef = np.empty((3, 3))
-    ff = np.empty((3, 3))
-    eth = np.empty((3, 2))
-    fth = np.empty((3, 2))
-    thth = np.empty(2)
+    h11, ee, ef, ff, eth, fth, thth = _contraction_scratch()
     te = np.empty(3)
     tf = np.empty(3)
     mixed = np.empty(STENCIL_SIZE)

@@ -21,7 +21,6 @@ from .protocol.driver import AfterStep, Loading, Run, execute
 from .protocol.progress import ProgressBar
 from .protocol.results import DynamicResult, RibbonResult, SimulationResult, base_summary
 from .protocol.steppers import ImplicitEulerStepper, RodDrivenStepper, StaticStepper, dynamic_loading
-from .solve.blas_threads import describe as describe_blas_threads
 from .solve.blas_threads import requested_threads as requested_blas_threads
 from .solve.continuation import ContinuationOptions
 from .solve.probe import SILENT, Probe
@@ -156,10 +155,7 @@ MAX_TRIANGLES = 1_000_000
 
 
 def _open_folder(out, summary: dict):
-    """The RunFolder of `out` (None if out is None), marked in progress with this summary (which
-    records the run's BLAS threads, ddg.solve.blas_threads: an invalid DDG_BLAS_THREADS is refused
-    here, before any work)."""
-    summary["blas_threads"] = describe_blas_threads()
+    """The RunFolder of `out` (None if out is None), marked in progress with this summary."""
     if out is None:
         return None
     from .output.io import RunFolder

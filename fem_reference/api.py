@@ -19,7 +19,6 @@ import numpy as np
 
 from ddg.geometry.strip import InputError, LoadingProtocol, Strip
 from ddg.protocol.results import SimulationResult
-from ddg.solve.blas_threads import describe as describe_blas_threads
 from ddg.solve.blas_threads import requested_threads
 from ddg.output.io import write_centerline_csv, write_path_csv, write_summary_json
 
@@ -210,7 +209,6 @@ def simulate(strip: Strip, protocol: LoadingProtocol, resolution: int = DEFAULT_
                            "no step computed")
         raise
     summary["material"] = material
-    summary["blas_threads"] = describe_blas_threads()
     summary["build_wall_time_s"] = time.perf_counter() - t_build
     if folder is not None:
         folder.checkpoint(summary)

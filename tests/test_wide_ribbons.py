@@ -307,7 +307,9 @@ def test_cross_section_curvature_change_per_width_of_a_sinusoid():
         model.commit(q, model.evaluate(q))
         indicators = model.resolution_indicators(q)
         expected = 2 * np.pi * strip.width / wavelength
-        assert indicators["curvature_change_per_width"] == pytest.approx(expected, rel=0.02)
+        # measured 0.26 % (lambda = L) and 0.32 % (L / 8) below: the difference quotient and the
+        # sampled maximum are O((2 pi h / lambda)^2); the bound is three times the larger
+        assert indicators["curvature_change_per_width"] == pytest.approx(expected, rel=0.01)
         note = model.stop_note(q)
         assert (note is not None) == expect_note
         if expect_note:

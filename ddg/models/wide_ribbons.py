@@ -32,7 +32,8 @@ import numpy as np
 
 from ..energies.cross_section import (CrossSectionModes, field_density, modes_curvature_form, torsion_warping,
                                       torsion_warping_stiffness)
-from ..energies.rod_curvature import add_stretched_stencil_terms, add_twist_pair_terms, material_curvatures
+from ..energies.rod_curvature import (STENCIL_SIZE, add_stretched_stencil_terms, add_twist_pair_terms,
+                                      material_curvatures)
 from ..energies.sadowsky import check_zeta
 from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_strain_blocks, stencil_stretch,
                                          stencil_stretch_values)
@@ -154,7 +155,7 @@ class CrossSectionRibbon(RodModel):
             f_uu[:-1, 3, 3] += pair_second[:, 0, 0]
             f_uu[1:, 3, 3] += pair_second[:, 1, 1]
             f_uu[[0, last], 3, 3] += end_second
-            tau_gradients = np.empty((len(tau), 11)) if hessian else np.empty((0, 11))
+            tau_gradients = np.empty((len(tau) if hessian else 0, STENCIL_SIZE))
             add_stretched_stencil_terms(x, m1, m2, self.rest_edge_lengths, f_u, f_uu, self.node_stride,
                                         self._mode_place, self.n_dof, grad, band, hessian, tau_gradients)
             if hessian:

@@ -16,6 +16,7 @@ import scipy
 from ..analysis.observables import resolved_up_to
 from ..geometry.strip import LoadingProtocol, Strip
 from ..output.interrupts import signal_name_of
+from ..solve.blas_threads import describe as describe_blas_threads
 from ..solve.thresholds import THRESHOLD_TOLERANCES
 from ..output.io import (STATUS_COMPLETE, STATUS_INTERRUPTED, STATUS_STOPPED, PathTable, write_centerline_csv,
                          write_path_csv, write_summary_json)
@@ -110,6 +111,7 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
         "n_free_dof": int(np.arange(model.n_dof)[model.free].size),
         "newton_iterations": 0,
         "newton_iterations_by_phase": None,
+        "blas_threads": describe_blas_threads(),   # what the run's BLAS uses (ddg.solve.blas_threads)
         "wall_time_s": None,
         "converged": False,
         "message": "",

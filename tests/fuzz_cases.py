@@ -511,6 +511,8 @@ def _api_table() -> list[tuple[str, str, Callable]]:
         add("NewtonOptions", f"give_up_after-{value!r}", _newton(give_up_after=value))
     for value in (NAN, -1.0, 1.5):
         add("NewtonOptions", f"give_up_ratio-{value!r}", _newton(give_up_ratio=value))
+    for value in (NAN, 0.0, -0.5, 1.5, True, "x"):
+        add("NewtonOptions", f"contraction_limit-{value!r}", _newton(contraction_limit=value))
     # ContinuationOptions
     for value in (0.0, -1.0, NAN, 2.0):
         add("ContinuationOptions", f"min_substep-{value!r}", _continuation(min_substep=value))

@@ -28,6 +28,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .extrapolation import ARCLENGTH_PREDICTOR_POINTS, lagrange_weights
 from .state import State
 
 
@@ -172,7 +173,7 @@ class ArclengthTracer:
                 return points, "stop condition"
             tangent = self.tangent(new, previous=tangent)
             travelled = history[-1][0] + ds
-            history = (history + [(travelled, new.q[free].copy(), new.shear)])[-3:]
+            history = (history + [(travelled, new.q[free].copy(), new.shear)])[-ARCLENGTH_PREDICTOR_POINTS:]
             if points and not keep_hessians and points[-1].evaluation is not None:
                 points[-1].evaluation = replace(points[-1].evaluation, hessian=None)
             points.append(new)
@@ -184,13 +185,13 @@ class ArclengthTracer:
         return points, "maximum number of points"
 
     def _predict(self, history, state: State, tangent, ds: float) -> tuple[np.ndarray, float]:
-        """Quadratic extrapolation in arclength through the last three states, else the tangent."""
+        """Polynomial extrapolation in arclength through the last states (up to
+        ARCLENGTH_PREDICTOR_POINTS, at least three), else the tangent."""
         free = self.model.free
         if len(history) < 3:
             return state.q[free] + ds * tangent[0], state.shear + ds * tangent[1]
-        s = np.array([h[0] for h in history])
-        target = s[-1] + ds
-        weights = [np.prod([(target - s[j]) / (s[i] - s[j]) for j in range(3) if j != i]) for i in range(3)]
+        s = [h[0] for h in history]
+        weights = lagrange_weights(s, s[-1] + ds)
         q = sum(w * h[1] for w, h in zip(weights, history))
         shear = sum(w * h[2] for w, h in zip(weights, history))
         return q, float(shear)

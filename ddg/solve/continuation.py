@@ -17,6 +17,7 @@ import numpy as np
 
 from ..geometry.strip import InputError
 from .arclength import ArclengthOptions, ArclengthTracer
+from .extrapolation import LOAD_PREDICTOR_POINTS, extrapolate
 from .probe import SILENT, Probe
 from .newton import ROUNDOFF_STALL_FACTOR, NewtonOptions, check_option, newton
 from .stability import lowest_modes
@@ -105,11 +106,12 @@ class PathFollower:
     def remember(self, state: State, restart: bool = False) -> None:
         if restart:
             self._history = []
-        self._history = (self._history + [(np.array([state.compression, state.shear]), state.q.copy())])[-3:]
+        self._history = (self._history + [(np.array([state.compression, state.shear]), state.q.copy())])[
+            -LOAD_PREDICTOR_POINTS:]
 
     def _extrapolate(self, compression: float, shear: float) -> np.ndarray | None:
-        """Polynomial extrapolation (secant, or quadratic through three points) of the last
-        equilibria on the current branch to the new load, if they lie on the same load line.
+        """Polynomial extrapolation (secant, up to a cubic through LOAD_PREDICTOR_POINTS points) of
+        the last equilibria on the current branch to the new load, if they lie on the same load line.
 
         On a curved branch it captures the second-order (membrane) part of the motion that the
         tangent predictor misses, which for thin plates decides whether Newton converges."""
@@ -131,9 +133,8 @@ class PathFollower:
             qs.append(q)
         if len(params) < 2 or len(set(params)) < len(params):
             return None
-        # Lagrange weights at t = 1 (the target); the last point sits at t = 0
-        weights = [np.prod([(1.0 - tj) / (ti - tj) for tj in params if tj is not ti]) for ti in params]
-        return sum(w * q for w, q in zip(weights, qs))
+        # the polynomial at t = 1 (the target); the last point sits at t = 0
+        return extrapolate(params, qs, 1.0)
 
     # ------------------------------------------------------------------ pieces
     def rest(self) -> State:
@@ -240,7 +241,7 @@ class PathFollower:
             # near thresholds Newton converges only linearly: more iterations, a milder give-up test
             give_up = 2 * opts.give_up_after if opts.give_up_after else None
             opts = replace(opts, max_iterations=min(2 * opts.max_iterations, 1000), give_up_after=give_up,
-                           give_up_ratio=0.5)
+                           give_up_ratio=0.5, contraction_limit=None)
         result = None
         extrapolated = None
         if self.options.predictor != "tangent" and self._history and np.array_equal(state.q, self._history[-1][1]):

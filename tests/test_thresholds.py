@@ -20,7 +20,7 @@ def narrow_rod():
 
 def test_rod_thresholds_match_the_paper_and_converge_in_M(narrow_rod):
     """W/L = 1/20, dL/L = 1/2: paper dW1/L ~ 0.36 and dW2/L ~ 0.52 (by eye, Fig. 6a). Measured:
-    0.3516 / 0.5237 at M = 100 and 0.3517 / 0.5245 at M = 200."""
+    0.3516 / 0.5235 at M = 100 (dW2 at the fold) and 0.3517 / 0.5245 at M = 200 (by bisection)."""
     coarse, fine = (narrow_rod[m].summary for m in (100, 200))
     assert coarse["dW1_over_L"] == pytest.approx(0.36, abs=0.02)
     assert coarse["dW2_over_L"] == pytest.approx(0.52, abs=0.02)
@@ -31,7 +31,7 @@ def test_rod_thresholds_match_the_paper_and_converge_in_M(narrow_rod):
 
 
 def test_rod_thresholds_at_quarter_compression():
-    """dL/L = 1/4: paper dW1/L = 0.23, dW2/L = 0.37 (Fig. 7a). Measured 0.2313 and 0.3699."""
+    """dL/L = 1/4: paper dW1/L = 0.23, dW2/L = 0.37 (Fig. 7a). Measured 0.2313 and 0.3693."""
     summary = rod_path(0.25).summary
     assert summary["dW1_over_L"] == pytest.approx(0.23, abs=0.02)
     assert summary["dW2_over_L"] == pytest.approx(0.37, abs=0.02)
@@ -186,3 +186,50 @@ def test_plate_dW1_near_the_paper_for_wide_plates(width_ratio, triangles, paper)
     protocol = ddg.LoadingProtocol(0.5, shear_ratio=paper + 0.05, compression_steps=20, shear_steps=30)
     result = ddg.simulate(strip, protocol, model="plate", resolution=triangles, branches=False)
     assert result.summary["dW1_over_L"] == pytest.approx(paper, abs=0.03)
+
+
+def test_dW2_at_a_fold_is_the_fold_itself_and_lies_in_the_bisections_bracket(narrow_rod, monkeypatch):
+    """W/L = 1/20, dL/L = 1/2: US joins S at S's own pitchfork, where the strip goes over to S, so
+    the turn of dW along the branch (the fold the path snaps at) is where S becomes stable: the
+    fold's dW2 equals dW2_S_stable (measured 2e-7 apart at M = 100, located independently: a
+    parabola's vertex on US against a sign change of lambda_min on S, bracket 1e-3). Bisection on
+    the phase (the fallback) lands within its 1e-3 bracket above it; the fold costs a fraction of
+    its iterations (measured 110 against 364 at M = 100)."""
+    import ddg.solve.thresholds as thresholds
+
+    fold = narrow_rod[100].summary
+    assert fold["dW2_located_by"] == "fold"
+    assert fold["dW2_over_L"] == pytest.approx(fold["dW2_S_stable_over_L"], abs=1e-5)
+    monkeypatch.setattr(thresholds, "locate_fold_snap", lambda *args, **kwargs: None)
+    bisection = rod_path(0.5, 100).summary
+    assert bisection["dW2_located_by"] == "bisection"
+    assert 0.0 <= bisection["dW2_over_L"] - fold["dW2_over_L"] <= thresholds.THRESHOLD_TOLERANCES[1]
+    assert fold["threshold_newton_iterations"] < 0.5 * bisection["threshold_newton_iterations"]
+
+
+def test_a_fold_that_does_not_snap_to_S_is_not_taken_for_dW2(monkeypatch):
+    """The descent just past the fold must land on S; with a criterion no state meets, the fold
+    locator declines (None) and the caller falls back to bisection."""
+    import ddg.solve.thresholds as thresholds
+
+    real = thresholds.locate_fold_snap
+    calls = []
+
+    def recording(*args):
+        calls.append(args)
+        return real(*args)
+
+    monkeypatch.setattr(thresholds, "locate_fold_snap", recording)
+    rod_path(0.5, 60)
+    (model, options, start, first_after, in_s, tolerance, _), = calls
+    assert real(model, options, start, first_after, in_s, tolerance) is not None
+    assert real(model, options, start, first_after, lambda state: False, tolerance) is None
+
+
+def test_the_fold_is_found_the_same_when_the_clamp_moves_the_other_way():
+    """shear_sign = -1 mirrors the scene: the fold is a minimum of dW there. Measured: dW2 equal to
+    6e-12 and located at the fold both ways."""
+    plus, minus = (ddg.simulate(ddg.Strip.from_ratios(0.05, 0.5), ddg.LoadingProtocol(0.5, shear_sign=sign),
+                                model="rod", resolution=100, branches=False).summary for sign in (1, -1))
+    assert plus["dW2_located_by"] == minus["dW2_located_by"] == "fold"
+    assert minus["dW2_over_L"] == pytest.approx(plus["dW2_over_L"], abs=1e-8)

@@ -67,11 +67,16 @@ def narrow_runs():
 @pytest.mark.parametrize("model", WIDE_RIBBONS)
 def test_ribbons_tend_to_the_rod_as_the_strip_narrows(model, narrow_runs):
     """At fixed thickness, W -> 0 takes W^2 / (b L) -> 0 and every ribbon to the rod: the gap of dW1
-    falls at each halving of W, below 2e-3 at W^2 / (b L) = 0.18 and 2e-4 at 0.046, and dW2 is the
-    rod's within 1e-3 at the two narrowest widths. Measured gaps of dW1 at 0.74 / 0.18 / 0.046:
-    sano-wada 8.9e-3 / 7.6e-4 / 6.5e-5, trapeze 1.2e-3 / 4.5e-4 / 4.4e-5, wunderlich 9.1e-3 /
-    7.6e-4 / 6.5e-5 (bounds ~2.5-3x the values at the two narrow widths); dW2 gaps <= 7e-4. The
-    cross-section ribbon tends to the rod with W/L (its clamp layer), see below."""
+    falls at each halving of W, below 2e-3 at W^2 / (b L) = 0.18 and 2e-4 at 0.046, and so does
+    the gap of dW2 between the two narrowest widths, below the same 2e-4 at 0.046. Measured gaps of
+    dW1 at 0.74 / 0.18 / 0.046: sano-wada 8.9e-3 / 7.6e-4 / 6.5e-5, trapeze 1.2e-3 / 4.5e-4 /
+    4.4e-5, wunderlich 9.1e-3 / 7.6e-4 / 6.5e-5 (bounds ~2.5-3x the values at the two narrow
+    widths). dW2 gaps at 0.18 / 0.046: sano-wada and wunderlich 1.28e-3 / 7.2e-5, trapeze 1.49e-3 /
+    9.7e-5 (falling ~16x per halving of W, as (W^2 / (b L))^2). Until dW2 was located at the fold
+    (issue 31) it came from a bisection biased up to its 1e-3 bracket, and this test bounded the dW2
+    gap by 1e-3 at both widths (measured <= 7e-4 then); the bound was changed after the precise
+    values were seen. The cross-section ribbon tends to the rod with W/L (its clamp layer), see
+    below."""
     gaps = []
     for w in NARROW_WIDTHS:
         rod, ribbon = narrow_runs[("rod", w)], narrow_runs[(model, w)]
@@ -90,8 +95,9 @@ def test_ribbons_tend_to_the_rod_as_the_strip_narrows(model, narrow_runs):
         return
     assert gaps[0] > gaps[1] > gaps[2], gaps
     assert gaps[1] < 2e-3 and gaps[2] < 2e-4, gaps
-    for w in NARROW_WIDTHS[1:]:
-        assert abs(narrow_runs[(model, w)]["dW2_over_L"] - narrow_runs[("rod", w)]["dW2_over_L"]) < 1e-3
+    dw2_gaps = [abs(narrow_runs[(model, w)]["dW2_over_L"] - narrow_runs[("rod", w)]["dW2_over_L"])
+                for w in NARROW_WIDTHS[1:]]
+    assert dw2_gaps[1] < dw2_gaps[0] and dw2_gaps[1] < 2e-4, dw2_gaps
 
 
 # --------------------------------------------------------------------------- trapeze: the tension's twist stiffness

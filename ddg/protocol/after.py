@@ -47,12 +47,14 @@ class Brackets:
 
 def locate_thresholds(summary: dict, model, options, brackets: Brackets) -> None:
     """dW1, dW2 and dW2_S_stable from stability, refined from the bracketing recorded states;
-    summary keys THRESHOLD_KEYS, threshold_wall_time_s, threshold_newton_iterations."""
+    summary keys THRESHOLD_KEYS, dW2_located_by ("fold", "bisection" or None: ddg.solve.thresholds),
+    threshold_wall_time_s, threshold_newton_iterations."""
     t0 = time.perf_counter()
     found = shear_thresholds(model, options, brackets.last_u, brackets.first_us, brackets.last_us, brackets.first_s)
     L = model.strip.length
     for key, name in zip(("dW1", "dW2", "dW2_S_stable"), THRESHOLD_KEYS):
         summary[name] = None if found[key] is None else abs(found[key]) / L
+    summary["dW2_located_by"] = found["dW2_method"]
     summary["threshold_wall_time_s"] = time.perf_counter() - t0
     summary["threshold_newton_iterations"] = found["newton_iterations"]
 

@@ -101,6 +101,7 @@ def base_summary(model_name: str, strip: Strip, protocol: LoadingProtocol, resol
         "dW1_over_L": None,
         "dW2_over_L": None,
         "dW2_S_stable_over_L": None,
+        "dW2_located_by": None,   # "fold" or "bisection" (ddg.solve.thresholds)
         "threshold_wall_time_s": None,
         "threshold_tolerances_over_L": {"dW1": THRESHOLD_TOLERANCES[0], "dW2": THRESHOLD_TOLERANCES[1]},
         "threshold_newton_iterations": None,

@@ -158,6 +158,9 @@ class ArclengthTracer:
             if new is None:
                 model.restore_frames(saved)
                 ds *= 0.5
+                # a failed step falls back to the quadratic through the last three states: a
+                # polynomial of higher order extrapolated over unevenly shrinking steps overshoots
+                history = history[-3:]
                 if ds < opts.min_step:
                     L = self._length
                     return points, (f"pseudo-arclength step below {opts.min_step:g} at dW/L = {state.shear / L:.6g} "

@@ -5,8 +5,12 @@ the stability of the discrete equilibria instead of by eye.
   eigenvalue of the free-DOF Hessian) changes sign; regula falsi (Illinois) on dW until the
   bracket is below the tolerance (1e-4 L by default).
 - dW2, the paper's: the smallest dW at which the stable path (branch switching on) is in the
-  point-symmetric S state; bisection on the phase label of the state reached from the last US
-  state (to 1e-3 L by default).
+  point-symmetric S state. Where US ends in a fold (a limit point in dW, where the strip snaps),
+  that is the fold itself: pseudo-arclength from the last US state goes round it, the fold's dW
+  is the vertex of the parabola through the three states about the turn (refined until they lie
+  within the tolerance), and an energy descent just past it confirms that the strip snaps to S
+  (locate_fold_snap). Otherwise, or if that check fails, bisection on the phase label of the
+  state reached from the last US state (to 1e-3 L by default).
 - dW2_S_stable: where the S branch itself becomes stable, lambda_min of S (followed backwards
   without switching) changing sign; it differs from dW2 when US ends in a fold and snaps to S.
 
@@ -19,7 +23,9 @@ from dataclasses import replace
 
 import numpy as np
 
+from .arclength import ArclengthOptions, ArclengthTracer
 from .continuation import ContinuationFailure, PathFollower
+from .newton import newton
 from .stability import lowest_modes
 from .state import Snapshot, State, phase_of
 
@@ -134,6 +140,105 @@ def locate_phase_change(model, options, start: Snapshot, first_after: float, is_
     return hi
 
 
+#: The arclength tracer's default largest step, which the fold's first pass may reach
+ARCLENGTH_MAX_STEP = ArclengthOptions().max_step
+ARCLENGTH_MIN_STEP = ArclengthOptions().min_step
+#: Refinements of the arclength step (each a quarter of the last) before the fold is given up
+FOLD_REFINEMENTS = 6
+#: Arclength states per pass towards the fold before it is given up (the first pass starts with a
+#: step of a quarter of the bracket, so about five reach it on a smooth branch)
+FOLD_POINTS = 40
+
+
+def _distance(states, tracer) -> list[float]:
+    """Arclength coordinates of consecutive states in the tracer's metric (the first at 0), or the
+    distance between two."""
+    free = tracer.model.free
+    s = [0.0]
+    for a, b in zip(states[:-1], states[1:]):
+        dq = b.q[free] - a.q[free]
+        s.append(s[-1] + float(np.sqrt(tracer.inner(dq, b.shear - a.shear, dq, b.shear - a.shear))))
+    return s if len(states) > 2 else s[1]
+
+
+def _vertex(states, tracer, direction: float) -> float:
+    """dW at the vertex of the parabola dW(s) through three consecutive arclength states about a
+    turn (s their arclength distances in the tracer's metric; the turn a maximum of dW for
+    direction +1, a minimum for -1)."""
+    s = _distance(states, tracer)
+    w = [direction * st.shear for st in states]
+    a2, a1, a0 = np.polyfit(np.array(s) - s[1], w, 2)
+    if a2 >= 0.0:
+        return direction * max(w)  # not a maximum: the turn is sharper than a parabola
+    peak = -a1 / (2.0 * a2)
+    inside = s[0] - s[1] <= peak <= s[2] - s[1]
+    return direction * (float(np.polyval([a2, a1, a0], peak)) if inside else max(w))
+
+
+def locate_fold_snap(model, options, start: Snapshot, first_after: float, is_after, tolerance: float,
+                     spent: list | None = None) -> float | None:
+    """dW of the fold where the branch through `start` (stable up to there) ends, if it lies in
+    (start.state.shear, first_after] and the strip snaps from it to a state with is_after(state);
+    None otherwise (no fold in the bracket, an instability before it, or another snap).
+
+    Pseudo-arclength goes from `start` towards first_after until dW turns back; the three states
+    about the turn bracket the fold, refined (from the last state before them, with a quarter of
+    the step) until their dW lie within `tolerance`. Then Newton's energy descent from the state
+    nearest the fold, with the clamp moved to the fold's dW plus `tolerance`, must land on a
+    stable state that is_after accepts: the state the path follower reaches there (it would fail
+    into the fold and snap the same way), without its failed solves."""
+    L = model.strip.length
+    direction = 1.0 if first_after >= start.state.shear else -1.0
+    step = abs(first_after - start.state.shear) / L / 4.0
+    origin, frames = start.state, start.frames
+    used = [0]
+    try:
+        for _ in range(FOLD_REFINEMENTS):
+            model.restore_frames(frames)
+            steps = ArclengthOptions(initial_step=step, max_step=max(16.0 * step, ARCLENGTH_MAX_STEP),
+                                     min_step=min(step / 64, ARCLENGTH_MIN_STEP), max_points=FOLD_POINTS)
+            tracer = ArclengthTracer(model, options.newton, steps)
+            seen = [origin.shear * direction]
+
+            def stop(state, seen=seen):
+                beyond = state.shear * direction
+                turned = beyond < seen[-1]
+                seen.append(beyond)
+                return turned or beyond > first_after * direction or is_after(state)
+
+            points, why = tracer.trace(origin, direction, stop=stop, keep_hessians=False)
+            used[0] += tracer.newton_iterations
+            if why != "stop condition" or len(points) < 1 or not (points[-1].shear * direction < seen[-2]):
+                return None  # no turn within the bracket (or S reached without a fold)
+            chain = [origin] + points
+            before, peak, after = chain[-3:] if len(chain) >= 3 else (None, None, None)
+            if before is None or not all(p.stable for p in chain[:-2]):
+                return None  # the branch loses stability before the fold: not a fold snap
+            if max(abs(peak.shear - before.shear), abs(peak.shear - after.shear)) <= tolerance:
+                fold = _vertex([before, peak, after], tracer, direction)
+                break
+            step = _distance([before, peak], tracer) / 4.0
+            frames = before.frames
+            model.restore_frames(frames)
+            origin = replace(before, evaluation=model.evaluate(before.q))  # its Hessian was not kept
+        else:
+            return None
+        # the snap: energy descent from the stable state nearest the fold, just past it
+        model.restore_frames(peak.frames if peak.stable else before.frames)
+        seed = peak if peak.stable else before
+        q = model.apply_clamps(seed.q, seed.compression, fold + direction * tolerance)
+        model.commit(q)
+        result = newton(model, q, options.newton, minimize=True)
+        used[0] += result.iterations
+        if not (result.converged and result.positive_definite):
+            return None
+        landed = State(result.q, result.evaluation, seed.compression, fold + direction * tolerance, True)
+        return fold if is_after(landed) else None
+    finally:
+        if spent is not None:
+            spent[0] += used[0]
+
+
 #: Bisection brackets (units of L) of dW1 and dW2 (dW2_S_stable uses dW2's); summary.json records
 #: them as threshold_tolerances_over_L, and the mesh studies add them to the error bars.
 THRESHOLD_TOLERANCES = (1e-4, 1e-3)
@@ -142,12 +247,13 @@ THRESHOLD_TOLERANCES = (1e-4, 1e-3)
 def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | None,
                      last_us: Snapshot | None, first_s: Snapshot | None,
                      tolerances: tuple[float, float] = THRESHOLD_TOLERANCES) -> dict:
-    """dW1, dW2 and dW2_S_stable (in metres; None where not bracketed by the recorded path), and
-    "newton_iterations": those spent locating them."""
+    """dW1, dW2 and dW2_S_stable (in metres; None where not bracketed by the recorded path),
+    "dW2_method" ("fold": the vertex of the fold US ends in, located by pseudo-arclength;
+    "bisection": on the phase reached; None) and "newton_iterations": those spent locating them."""
 
     L = model.strip.length
     saved = model.save_frames()
-    out = {"dW1": None, "dW2": None, "dW2_S_stable": None}
+    out = {"dW1": None, "dW2": None, "dW2_S_stable": None, "dW2_method": None}
     spent = [0]
     try:
         if last_u is not None and first_us is not None:
@@ -156,8 +262,12 @@ def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | 
             def in_s(state):
                 return phase_of(model, state).startswith("S")
 
-            out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L,
-                                               spent)
+            out["dW2"] = locate_fold_snap(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L, spent)
+            out["dW2_method"] = "fold"
+            if out["dW2"] is None:
+                out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L,
+                                                   spent)
+                out["dW2_method"] = "bisection" if out["dW2"] is not None else None
             out["dW2_S_stable"] = locate_sign_change(model, options, first_s, last_us.state.shear, tolerances[1] * L,
                                                      spent)
     finally:

@@ -590,6 +590,14 @@ def load_line(report: dict) -> str:
             f"{report['load_average'][1]} (other processes on the machine inflate wall times)")
 
 
+def loads_line(report: dict, loads) -> str:
+    """The closing line of the child-process benchmarks: the load average before each run, the
+    cores, the date and the ddg sources (report: machine, source)."""
+    return (f"Load average (1 min) before each run: {', '.join(str(x) for x in loads)}; "
+            f"{report['machine']['cpu_count']} cores; {report['machine']['date']}; "
+            f"ddg sources {report['source'][:12]}.")
+
+
 def run_notes(results: list[dict], label, note) -> list[str]:
     """note(r) for each successful run r, "<label(r)>: <status> (<error>)" for the others."""
     return [note(r) if r["status"] == "ok" else f"{label(r)}: {r['status']} ({r.get('error', '')})".strip()

@@ -10,11 +10,12 @@ For each case (model, W/L, resolution) it runs the full default path with thresh
                  options=ContinuationOptions(newton=NewtonOptions(contraction_limit=...)),
                  branches=False)
 
-once with the test off (None, the default) and once with it on (--limit), each in a fresh child
-process after `python -m ddg warmup`, and reports the path's Newton iterations (with the failed
-solves' and the fold snaps'), the threshold location's, the wall time (summary wall_time_s),
-the status, dW1/L, dW2/L, dW2_S_stable/L and the folds met. Writes OUT/newton_contraction.json
-and .md atomically. Not part of the test run; no timing is asserted anywhere.
+once with the test off (None) and once with it on (--limit; 0.5 is the default), each in a fresh
+child process after `python -m ddg warmup` and an untimed short run of the same model (which loads
+or compiles every kernel it uses: the warm-up does not cover every model's), and reports the
+path's Newton iterations (with the failed solves' and the fold snaps'), the threshold location's,
+the wall time (summary wall_time_s), the status, dW1/L, dW2/L, dW2_S_stable/L and the folds met.
+Writes OUT/newton_contraction.json and .md atomically. Not part of the test run; no timing is asserted anywhere.
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from benchmarks.common import load_average, machine_info, source_fingerprint, write_report
+from benchmarks.common import load_average, loads_line, machine_info, source_fingerprint, write_report
 
 #: (model, W/L, resolution): the rod and the 1D models at M ~ 100, both plates at ~2000 triangles
 CASES = (("rod", 1 / 20, 100), ("rod", 1 / 20, 400), ("ribbon", 1 / 20, 101), ("ribbon-sano-wada", 1 / 20, 101),
@@ -40,8 +41,11 @@ import ddg
 model, w, n = sys.argv[1], float(sys.argv[2]), int(sys.argv[3])
 limit = None if sys.argv[4] == "none" else float(sys.argv[4])
 options = ddg.ContinuationOptions(newton=ddg.NewtonOptions(contraction_limit=limit))
-r = ddg.simulate(ddg.Strip.from_ratios(w, 0.5), ddg.LoadingProtocol(0.5), model=model, resolution=n,
-                 options=options, branches=False)
+strip = ddg.Strip.from_ratios(w, 0.5)
+# untimed: loads (or compiles) every kernel the model uses, which `ddg warmup` may not cover
+ddg.simulate(strip, ddg.LoadingProtocol(0.5, 0.05, compression_steps=4, shear_steps=2), model=model, resolution=n,
+             branches=False)
+r = ddg.simulate(strip, ddg.LoadingProtocol(0.5), model=model, resolution=n, options=options, branches=False)
 s = r.summary
 keys = ("status", "wall_time_s", "newton_iterations", "newton_iterations_by_phase", "threshold_newton_iterations",
         "dW1_over_L", "dW2_over_L", "dW2_S_stable_over_L", "folds_dW_over_L", "resolved_up_to_dW_over_L")
@@ -79,8 +83,9 @@ def _difference(off: dict, on: dict, key: str) -> str:
 def markdown(report: dict) -> str:
     limit = report["limit"]
     lines = ["# Newton's fail-fast on contraction (benchmarks/newton_contraction.py)", "",
-             f"Full default path with thresholds, dL/L = 1/2, no branch tracing; each run in a fresh process. off = "
-             f"`NewtonOptions(contraction_limit=None)` (the default), on = `contraction_limit={limit}`. Path its = "
+             f"Full default path with thresholds, dL/L = 1/2, no branch tracing; each run in a fresh process after an "
+             f"untimed short run of the same model. off = `NewtonOptions(contraction_limit=None)`, on = "
+             f"`contraction_limit={limit}` (0.5 is the default). Path its = "
              f"`summary['newton_iterations']` (failed solves and fold snaps included); threshold its = "
              f"`threshold_newton_iterations`; wall = `wall_time_s` (one run each: a guide, not a benchmark of speed).",
              "", "| model | W/L | M or N | status off / on | path its off / on | failed-solve its off / on | "
@@ -117,9 +122,7 @@ def markdown(report: dict) -> str:
     lines += ["", f"Path iterations fewer with the test on in {fewer} of {len(saved)} cases; "
                   f"status changed in: {', '.join(complete_changed) if complete_changed else 'none'}."]
     loads = [r[k].get("load_average") for r in report["rows"] for k in ("off", "on")]
-    lines += ["", f"Load average (1 min) before each run: {', '.join(str(x) for x in loads)}; "
-                  f"{report['machine']['cpu_count']} cores; {report['machine']['date']}; "
-                  f"ddg sources {report['source'][:12]}."]
+    lines += ["", loads_line(report, loads)]
     return "\n".join(lines) + "\n"
 
 

@@ -25,7 +25,7 @@ import time
 from fractions import Fraction
 from pathlib import Path
 
-from benchmarks.common import load_average, machine_info, source_fingerprint, write_report
+from benchmarks.common import load_average, loads_line, machine_info, source_fingerprint, write_report
 
 SETTINGS = ("1", "keep")
 CHILD = """
@@ -99,9 +99,7 @@ def markdown(report: dict) -> str:
                      f"{idle.get('newton_iterations', '-')} | {busy.get('wall_time_s', float('nan')):.1f} | "
                      f"{busy.get('newton_iterations', '-')} | {slow} | {target} |")
     loads = [r[k].get("load_average") for r in report["rows"] for k in ("idle", "busy")]
-    lines += ["", f"Load average (1 min) before each run: {', '.join(str(x) for x in loads)}; "
-                  f"{report['machine']['cpu_count']} cores; {report['machine']['date']}; "
-                  f"ddg sources {report['source'][:12]}."]
+    lines += ["", loads_line(report, loads)]
     return "\n".join(lines) + "\n"
 
 

@@ -73,5 +73,36 @@ def test_a_bad_contraction_limit_is_refused_in_one_line(value):
         NewtonOptions(contraction_limit=value)
 
 
-def test_the_default_is_off():
-    assert NewtonOptions().contraction_limit is None
+def test_the_default_is_on():
+    assert NewtonOptions().contraction_limit == 0.5
+
+
+def test_a_path_that_would_stop_with_the_test_retries_without_it(monkeypatch):
+    """Before a path is given up the follower switches the fail-fast off and retries: here every
+    solve that has the test on fails at once, and the path still completes, equal to a run with the
+    test off."""
+    import ddg.solve.continuation as continuation
+    from ddg.solve.newton import NewtonResult
+
+    real = continuation.newton
+    refused, retried = [], []
+    patient = 2 * NewtonOptions().max_iterations
+
+    def refusing(model, q, options=None, **kwargs):
+        load_step = not kwargs.get("minimize")
+        if load_step and options.contraction_limit is None and options.max_iterations < patient:
+            retried.append(1)  # a load step without the test and not patient: the retry
+        elif not retried and (load_step or refused):
+            # after the first buckled state every solve fails until the follower retries without the test
+            refused.append(1)
+            return NewtonResult(q, None, False, 1, float("inf"), None, "Newton corrections not contracting")
+        return real(model, q, options, **kwargs)
+
+    protocol = ddg.LoadingProtocol(0.5, 0.2, compression_steps=10, shear_steps=10)
+    off = ddg.simulate(SCENE, protocol, model="rod", resolution=40, branches=False, thresholds=False,
+                       options=ddg.ContinuationOptions(newton=NewtonOptions(contraction_limit=None)))
+    monkeypatch.setattr(continuation, "newton", refusing)
+    on = ddg.simulate(SCENE, protocol, model="rod", resolution=40, branches=False, thresholds=False)
+    assert refused and retried and on.summary["status"] == "complete"
+    assert on.summary["H_mid_over_L_compressed"] == pytest.approx(off.summary["H_mid_over_L_compressed"], abs=1e-9)
+    assert on.rows[-1]["H_mid_over_L"] == pytest.approx(off.rows[-1]["H_mid_over_L"], abs=1e-9)

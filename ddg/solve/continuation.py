@@ -91,6 +91,9 @@ class PathFollower:
         #: Newton iterations per phase of the path (PHASES), the public record of where they go
         self.iterations_by_phase: dict[str, int] = dict.fromkeys(PHASES, 0)
         self.line_search_trials = 0  # shortened Newton steps tried in load steps (evaluations, not iterations)
+        #: the load steps use Newton's fail-fast on contraction (if the options ask) until a path
+        #: would stop with it; then it is off for the rest of this follower
+        self._fail_fast = self.options.newton.contraction_limit is not None
 
     def iteration_breakdown(self) -> dict[str, int]:
         """Newton iterations per phase and the line search's shortened steps (summary.json's
@@ -196,6 +199,14 @@ class PathFollower:
             if new is None:
                 self._easy_streak = 0
                 self.substep *= 0.5
+                if self.substep < self.options.min_substep and self._fail_fast:
+                    # the load steps' fail-fast (NewtonOptions.contraction_limit) gives up solves
+                    # that might converge slowly: before the path is given up, it is switched off
+                    # for the rest of this follower and the rest of the interval retried from the
+                    # last equilibrium
+                    self._fail_fast = False
+                    self.substep = 1.0
+                    continue
                 if self.substep < self.options.min_substep:
                     strip = self.model.strip
                     limit = strip.shear_limit(state.compression) if state.compression > 0 else float("nan")
@@ -236,7 +247,7 @@ class PathFollower:
         model = self.model
         saved = model.save_frames()
         new_clamps = model.clamp_values(compression, shear)
-        opts = self.options.newton
+        opts = self.options.newton if self._fail_fast else replace(self.options.newton, contraction_limit=None)
         if patient:
             # near thresholds Newton converges only linearly: more iterations, a milder give-up test
             give_up = 2 * opts.give_up_after if opts.give_up_after else None

@@ -213,10 +213,10 @@ def test_midedge_path_leaves_U_continuously_and_reaches_S_through_one_transition
 #: machine, OpenBLAS on one thread; speed_accuracy.json, benchmarks/speed_accuracy.py). The tests read
 #: the stored benchmarks; they time nothing.
 SPEED_MISSES = {
-    "targets": "issue 29 target not met: W/L = 1/6, dL/L = 1/2, full path with thresholds: 8 rows 30.11 s "
-               "(target 8 s), 12 rows 74.22 s (target 20 s); 15.47 and 14.75 Newton iterations per recorded step "
-               "(target 6): of the 2491 iterations on 8 rows, 676 are in failed solves, 431 in fold snaps and 224 "
-               "in branch switching (14 branch switches along the path)",
+    "targets": "issue 29 target not met: W/L = 1/6, dL/L = 1/2, full path with thresholds: 8 rows 23.83 s "
+               "(target 8 s), 12 rows 55.22 s (target 20 s); 12.83 and 11.58 Newton iterations per recorded step "
+               "(target 6): of the 2066 iterations on 8 rows, 342 are in failed solves, 434 in fold snaps and 224 "
+               "in branch switching (19 branch switches along the path)",
     "speedup": "issue 29 target not met (speed_accuracy.md, W/L = 1/6, dL/L = 1/2, idle machine): the cheapest "
                "mid-edge run within 0.003 L of the FEM's converged dW1/L (0.2654 +- 0.0031) is 28 rows, 711.8 s "
                "(error 0.0027); the FEM's is 96 x 12, 175.2 s (error 0.0017): FEM time / mid-edge time 0.25 against "

@@ -31,7 +31,11 @@ from .state import Snapshot, State, phase_of
 
 
 def _follower(model, options, switching: bool) -> PathFollower:
-    return PathFollower(model, replace(options, branch_switching=switching))
+    """A path follower for the refinements: near the thresholds Newton converges only linearly, so
+    without the load steps' fail-fast on contraction (NewtonOptions.contraction_limit; with it the
+    rod's threshold location at M = 400 took 1556 Newton iterations against 968, measured)."""
+    newton_options = replace(options.newton, contraction_limit=None)
+    return PathFollower(model, replace(options, newton=newton_options, branch_switching=switching))
 
 
 def _advance(model, options, snapshot: Snapshot, shear: float, switching: bool,

@@ -78,9 +78,10 @@ class NewtonOptions:
     # converges more slowly than the rate 1/2 of Newton at a singular point, and a shorter load step
     # is cheaper. Off near thresholds (the patient steps, where Newton converges linearly) and, for
     # the rest of a path, once the path would stop with it (PathFollower); None switches it off.
-    # Measured (benchmarks/results/newton_contraction.md, 11 models and scenes): 2-13 % fewer path
-    # iterations everywhere, thresholds unchanged to 1.2e-6 L, the paper's plate at W/L = 1/6
-    # 18.1 -> 14.6 s.
+    # Measured (benchmarks/results/newton_contraction.md, 11 models and scenes): 1-13 % fewer path
+    # iterations on the 8 paths that complete, thresholds unchanged to 1.2e-6 L, no status changed,
+    # the paper's plate at W/L = 1/6 17.9 -> 14.6 s; the 3 paths that stop anyway (Wunderlich,
+    # cross-section) spend 36-62 % more before they stop, retrying without the test.
     contraction_limit: float | None = 0.5
 
     def __post_init__(self) -> None:

@@ -201,3 +201,19 @@ def test_a_trace_without_hessians_keeps_only_the_last_one():
     assert all(s.evaluation.hessian is None for s in light[:-1]) and light[-1].evaluation.hessian is not None
     for a, b in zip(kept, light):
         assert np.array_equal(a.q, b.q) and a.shear == b.shear and a.evaluation.energy == b.evaluation.energy
+
+
+def test_a_fine_rod_traces_every_branch_to_its_end():
+    """At M = 400 the stretching makes Newton's residual stall at 3-4 times the model's round-off
+    floor estimate. The corrector accepts that as converged, as Newton does (a correction below
+    step_tol, the residual within ROUNDOFF_STALL_FACTOR of the floor); before, every corrector there
+    failed and U ended at dW/L = 0.092 after 15 states, S after one. Measured now: U 55 states to
+    the end of the shear, US+ and US- 37 each to S, S+ 68; dW2 is then found at the fold."""
+    result = run("rod", 400, None, 120)
+    branches = result.summary["branches"]
+    assert list(branches) == ["U", "US+", "US-", "S+"]
+    assert branches["U"]["end"] == branches["S+"]["end"] == "left the shear range"
+    assert branches["US+"]["end"] == branches["US-"]["end"] == "stop condition"
+    assert min(b["points"] for b in branches.values()) >= 20
+    assert result.summary["dW2_located_by"] == "fold"
+    assert result.summary["dW2_over_L"] == pytest.approx(result.summary["dW2_S_stable_over_L"], abs=1e-5)

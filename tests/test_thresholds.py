@@ -20,7 +20,7 @@ def narrow_rod():
 
 def test_rod_thresholds_match_the_paper_and_converge_in_M(narrow_rod):
     """W/L = 1/20, dL/L = 1/2: paper dW1/L ~ 0.36 and dW2/L ~ 0.52 (by eye, Fig. 6a). Measured:
-    0.3516 / 0.5235 at M = 100 (dW2 at the fold) and 0.3517 / 0.5245 at M = 200 (by bisection)."""
+    0.3516 / 0.5235 at M = 100 and 0.3517 / 0.5237 at M = 200 (dW2 at the fold)."""
     coarse, fine = (narrow_rod[m].summary for m in (100, 200))
     assert coarse["dW1_over_L"] == pytest.approx(0.36, abs=0.02)
     assert coarse["dW2_over_L"] == pytest.approx(0.52, abs=0.02)

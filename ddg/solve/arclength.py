@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .extrapolation import ARCLENGTH_PREDICTOR_POINTS, lagrange_weights
+from .newton import ROUNDOFF_STALL_FACTOR
 from .state import State
 
 
@@ -61,6 +62,8 @@ class ArclengthTracer:
         self._length = model.strip.length
         self._residual_scale = model.residual_scale()[model.free]
         self._residual_tol = max(newton_options.residual_tol, model.residual_floor())
+        self._roundoff = ROUNDOFF_STALL_FACTOR * model.residual_floor()
+        self._length_scale = model.length_scale()[model.free]
 
     # ------------------------------------------------------------------ geometry of the branch
     def inner(self, a_q: np.ndarray, a_w: float, b_q: np.ndarray, b_w: float) -> float:
@@ -101,7 +104,7 @@ class ArclengthTracer:
         q = q.copy()
         q[model.constrained] = model.clamp_values(compression, shear)
         ev = model.evaluate(q)
-        first = None
+        first, correction = None, np.inf
         for iteration in range(self.options.max_iterations + 1):
             if not np.all(np.isfinite(ev.gradient)):
                 return None
@@ -109,7 +112,12 @@ class ArclengthTracer:
             res = float(np.max(np.abs(r / self._residual_scale)))
             arc = self.inner(q[free] - anchor.q[free], shear - anchor.shear, t_q, t_w) - ds
             K = model.free_matrix(ev.hessian)
-            if res < self._residual_tol and abs(arc) < 1e-8 * ds:
+            # converged, or converged to round-off as newton() judges it: the last correction below
+            # step_tol with the residual within ROUNDOFF_STALL_FACTOR of the model's floor (the rod
+            # at M = 400 stalls at 3-4 times its floor estimate; without this every corrector there
+            # failed and the branches ended after a few states)
+            settled = res < self._residual_tol or (correction < self.newton_options.step_tol and res <= self._roundoff)
+            if settled and abs(arc) < 1e-8 * ds:
                 return State(q, ev, compression, shear, bool(K.cholesky()), iteration)
             if iteration == self.options.max_iterations:
                 return None
@@ -119,7 +127,9 @@ class ArclengthTracer:
             f_w = model.coupling(ev.hessian, rate)
             a, b = K.solve(np.column_stack([-r, -f_w])).T
             d_w = (-arc - self.inner(a, 0.0, t_q, t_w)) / (self.inner(b, 0.0, t_q, t_w) + t_w / self._length**2)
-            q[free] += a + b * d_w
+            step = a + b * d_w
+            correction = float(np.max(np.abs(step / self._length_scale)))
+            q[free] += step
             shear += d_w
             q[model.constrained] = model.clamp_values(compression, shear)
             ev = model.evaluate(q)

@@ -208,7 +208,8 @@ def test_a_fine_rod_traces_every_branch_to_its_end():
     floor estimate. The corrector accepts that as converged, as Newton does (a correction below
     step_tol, the residual within ROUNDOFF_STALL_FACTOR of the floor); before, every corrector there
     failed and U ended at dW/L = 0.092 after 15 states, S after one. Measured now: U 55 states to
-    the end of the shear, US+ and US- 37 each to S, S+ 68; dW2 is then found at the fold."""
+    the end of the shear, US+ and US- 37 each to S, S+ 68; dW2 is then found at the fold, 2.3e-6 from
+    where S turns stable (bound 1e-5, about four times that)."""
     result = run("rod", 400, None, 120)
     branches = result.summary["branches"]
     assert list(branches) == ["U", "US+", "US-", "S+"]

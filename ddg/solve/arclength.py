@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .extrapolation import ARCLENGTH_PREDICTOR_POINTS, lagrange_weights
-from .newton import ROUNDOFF_STALL_FACTOR
+from .newton import settled
 from .state import State
 
 
@@ -61,8 +61,6 @@ class ArclengthTracer:
         self._weight2 = 1.0 / (free.size * model.length_scale()[model.free] ** 2)
         self._length = model.strip.length
         self._residual_scale = model.residual_scale()[model.free]
-        self._residual_tol = max(newton_options.residual_tol, model.residual_floor())
-        self._roundoff = ROUNDOFF_STALL_FACTOR * model.residual_floor()
         self._length_scale = model.length_scale()[model.free]
 
     # ------------------------------------------------------------------ geometry of the branch
@@ -112,12 +110,10 @@ class ArclengthTracer:
             res = float(np.max(np.abs(r / self._residual_scale)))
             arc = self.inner(q[free] - anchor.q[free], shear - anchor.shear, t_q, t_w) - ds
             K = model.free_matrix(ev.hessian)
-            # converged, or converged to round-off as newton() judges it: the last correction below
-            # step_tol with the residual within ROUNDOFF_STALL_FACTOR of the model's floor (the rod
-            # at M = 400 stalls at 3-4 times its floor estimate; without this every corrector there
-            # failed and the branches ended after a few states)
-            settled = res < self._residual_tol or (correction < self.newton_options.step_tol and res <= self._roundoff)
-            if settled and abs(arc) < 1e-8 * ds:
+            # converged as newton() judges it, round-off stalls included (the rod at M = 400 stalls at
+            # 3-4 times its floor estimate: without them every corrector there failed and the
+            # branches ended after a few states)
+            if settled(model, self.newton_options, res, correction) and abs(arc) < 1e-8 * ds:
                 return State(q, ev, compression, shear, bool(K.cholesky()), iteration)
             if iteration == self.options.max_iterations:
                 return None

@@ -19,7 +19,7 @@ from ..geometry.strip import InputError
 from .arclength import ArclengthOptions, ArclengthTracer
 from .extrapolation import LOAD_PREDICTOR_POINTS, extrapolate
 from .probe import SILENT, Probe
-from .newton import ROUNDOFF_STALL_FACTOR, NewtonOptions, check_option, newton
+from .newton import NewtonOptions, check_option, newton, settled
 from .stability import lowest_modes
 from .state import State, asymmetry, crosses, phase_of
 
@@ -444,9 +444,7 @@ class PathFollower:
         w = direction[free]
         ww = float(w @ w)
         rscale = model.residual_scale()[free]
-        tol = max(self.options.newton.residual_tol, model.residual_floor())
         lscale = model.length_scale()[free]
-        roundoff = ROUNDOFF_STALL_FACTOR * model.residual_floor()
         q = q.copy()
         mu, first, correction = 0.0, None, np.inf
         ev = model.evaluate(q)
@@ -456,10 +454,7 @@ class PathFollower:
             res = float(np.max(np.abs(r / rscale)))
             if not np.isfinite(res):
                 return None
-            # converged, or converged to round-off as newton() judges it (a correction below
-            # step_tol with the residual within ROUNDOFF_STALL_FACTOR of the model's floor)
-            if (res < tol or (correction < self.options.newton.step_tol and res <= roundoff)) \
-                    and abs(c) < 1e-12 * self._length:
+            if settled(model, self.options.newton, res, correction) and abs(c) < 1e-12 * self._length:
                 return q, ev, mu
             first = res if first is None else first
             if iteration == self.options.newton.max_iterations or res > 1e3 * first:

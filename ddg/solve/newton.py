@@ -109,6 +109,16 @@ class NewtonResult:
     line_search_trials: int = 0  # shortened steps tried (each an energy or gradient evaluation)
 
 
+def settled(model, options: "NewtonOptions", residual: float, correction: float) -> bool:
+    """A bordered or plain Newton iterate is converged: its scaled residual below the tolerance
+    (raised to the model's round-off floor), or converged to round-off as newton() judges a stall:
+    the last correction below step_tol (relative to the model's length scale) with the residual
+    within ROUNDOFF_STALL_FACTOR of the floor."""
+    floor = model.residual_floor()
+    return residual < max(options.residual_tol, floor) or (
+        correction < options.step_tol and residual <= ROUNDOFF_STALL_FACTOR * floor)
+
+
 def scaled_residual(model, gradient: np.ndarray) -> float:
     free = model.free
     return float(np.max(np.abs(gradient[free] / model.residual_scale()[free]), initial=0.0))

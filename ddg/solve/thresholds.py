@@ -164,22 +164,21 @@ FOLD_REFINEMENTS = 6
 FOLD_POINTS = 20
 
 
-def _distance(states, tracer) -> list[float]:
-    """Arclength coordinates of consecutive states in the tracer's metric (the first at 0), or the
-    distance between two."""
+def _arclengths(states, tracer) -> list[float]:
+    """Arclength coordinates of consecutive states in the tracer's metric (the first at 0)."""
     free = tracer.model.free
     s = [0.0]
     for a, b in zip(states[:-1], states[1:]):
         dq = b.q[free] - a.q[free]
         s.append(s[-1] + float(np.sqrt(tracer.inner(dq, b.shear - a.shear, dq, b.shear - a.shear))))
-    return s if len(states) > 2 else s[1]
+    return s
 
 
 def _vertex(states, tracer, direction: float) -> float:
     """dW at the vertex of the parabola dW(s) through three consecutive arclength states about a
     turn (s their arclength distances in the tracer's metric; the turn a maximum of dW for
     direction +1, a minimum for -1)."""
-    s = _distance(states, tracer)
+    s = _arclengths(states, tracer)
     w = [direction * st.shear for st in states]
     a2, a1, a0 = np.polyfit(np.array(s) - s[1], w, 2)
     if a2 >= 0.0:
@@ -231,7 +230,7 @@ def locate_fold_snap(model, options, start: Snapshot, first_after: float, is_aft
             if max(abs(peak.shear - before.shear), abs(peak.shear - after.shear)) <= tolerance:
                 fold = _vertex([before, peak, after], tracer, direction)
                 break
-            step = _distance([before, peak], tracer) / 4.0
+            step = _arclengths([before, peak], tracer)[1] / 4.0
             frames = before.frames
             model.restore_frames(frames)
             origin = replace(before, evaluation=model.evaluate(before.q))  # its Hessian was not kept

@@ -48,8 +48,10 @@ WIDTH_RATIO = 0.05
 COMPRESSION_RATIO = 0.5
 COMPRESSION_STEPS = 40
 SHEAR_STEPS = 120
-CATEGORIES = ("evaluate", "linalg", "eigen")
+CATEGORIES = ("compiled", "evaluate", "linalg", "eigen")
 CATEGORY_LABELS = {
+    "compiled": "the compiled Newton load steps and pseudo-arclength corrections (ddg.solve.compiled_newton: "
+                "their evaluations, factorisations and solves inside one call each)",
     "evaluate": "energy/gradient/Hessian (RodModel.evaluate)",
     "linalg": "linear algebra (SymmetricBanded.cholesky, .solve, .ldlt)",
     "eigen": "eigenvalues (stability.lowest_modes, SymmetricBanded.lowest_eigenpairs)",
@@ -63,12 +65,16 @@ def category_functions(previous: bool = False) -> dict:
     the reports up to issue 14 (eigen = lowest_eigenpairs only, so lowest_modes' compiled Lanczos
     counted as other and its Cholesky as linear algebra; no ldlt entry)."""
     from ddg.models.rod import RodModel
+    from ddg.solve import newton
+    from ddg.solve.arclength import ArclengthTracer
     from ddg.solve.banded import SymmetricBanded as SB
     from ddg.solve.stability import lowest_modes
 
+    compiled = [newton._compiled, ArclengthTracer._correct_compiled]
     if previous:
-        return {"evaluate": [RodModel.evaluate], "linalg": [SB.cholesky, SB.solve], "eigen": [SB.lowest_eigenpairs]}
-    return {"evaluate": [RodModel.evaluate], "linalg": [SB.cholesky, SB.solve, SB.ldlt],
+        return {"compiled": compiled, "evaluate": [RodModel.evaluate], "linalg": [SB.cholesky, SB.solve],
+                "eigen": [SB.lowest_eigenpairs]}
+    return {"compiled": compiled, "evaluate": [RodModel.evaluate], "linalg": [SB.cholesky, SB.solve, SB.ldlt],
             "eigen": [lowest_modes, SB.lowest_eigenpairs]}
 
 
@@ -143,7 +149,7 @@ def measure(nodes: int, compression_steps: int = COMPRESSION_STEPS, shear_steps:
 
 # ---------------------------------------------------------------------------- reporting
 HEADER = ("M", "free DOF", "first call s", "wall s", "cpu s", "Newton its", "ms/it", "steps", "conv", "evals",
-          "ms/eval", "eval %", "linalg %", "eig %", "other %", "H_mid/L", "rel err vs elastica")
+          "ms/eval", "loop %", "eval %", "linalg %", "eig %", "other %", "H_mid/L", "rel err vs elastica")
 
 
 def table_rows(results: list[dict]) -> list[tuple]:
@@ -159,7 +165,8 @@ def table_rows(results: list[dict]) -> list[tuple]:
             f"{r['cpu_time_s']:.2f}", str(r["newton_iterations"]), f"{r['time_per_newton_iteration_ms']:.2f}",
             str(r["recorded_steps"]), "yes" if r["converged"] else "NO",
             str(r["evaluations"]), f"{r['time_per_evaluation_ms']:.2f}" if r["time_per_evaluation_ms"] else "",
-            f"{100 * f['evaluate']:.0f}", f"{100 * f['linalg']:.0f}", f"{100 * f['eigen']:.0f}",
+            f"{100 * f['compiled']:.0f}", f"{100 * f['evaluate']:.0f}", f"{100 * f['linalg']:.0f}",
+            f"{100 * f['eigen']:.0f}",
             f"{100 * f['other']:.0f}",
             f"{r['H_mid_over_L_compressed']:.6f}" if r["H_mid_over_L_compressed"] is not None else "",
             f"{err:+.2e}" if err is not None else "",
@@ -242,15 +249,18 @@ def markdown_report(report: dict) -> str:
         "`ddg.solve.probe.Probe` (every Newton solve and recorded step; no profiler, no patching). cpu s = CPU time of "
         "the benchmark process during the same call (wall time above it means the process waited for a core, or for "
         "BLAS threads). Newton its = `summary['newton_iterations']` (the path; threshold location and branch "
-        "tracing are counted apart, below). evals = calls of RodModel.evaluate (Newton iterations plus line-search "
-        "trials and the first evaluation of each solve), counted by cProfile in the profiled call (the same, "
-        "deterministic path); ms/eval = their mean time (scaled as the split). "
+        "tracing are counted apart, below). evals = calls of RodModel.evaluate from Python (since issue 31 the "
+        "Newton load steps and arclength corrections evaluate inside their compiled loop, uncounted: these are "
+        "the rest, e.g. threshold location's descents and the recorded states' re-evaluations), counted by "
+        "cProfile in the profiled call (the same, deterministic path); ms/eval = their mean time (scaled as the "
+        "split). "
         "Time split columns (share of the wall time), **measured under cProfile** in a third, separate warm call "
         "of the same run and **scaled to the un-profiled wall time**: each category's outermost calls (a category's "
         "call inside another category's call counts once, for the outer one) as a share of the profiled call's wall "
         f"time (which cProfile's per-call overhead makes {_overhead(results)} times the un-profiled one; the "
         "overhead falls on Python calls, so the shares lean a little towards the Python-heavy categories). "
-        "eval = " + CATEGORY_LABELS["evaluate"] + "; linalg = " + CATEGORY_LABELS["linalg"] + "; eig = "
+        "loop = " + CATEGORY_LABELS["compiled"] + "; eval = " + CATEGORY_LABELS["evaluate"] + "; linalg = "
+        + CATEGORY_LABELS["linalg"] + "; eig = "
         + CATEGORY_LABELS["eigen"] + " (including their own factorisations, the compiled Lanczos on the Cholesky "
         "factor and ARPACK's solves); other = " + CATEGORY_LABELS["other"] + ". Until issue 15 the eig column "
         "counted lowest_eigenpairs only (lowest_modes' compiled Lanczos was in other, its Cholesky in linalg); "
@@ -328,7 +338,8 @@ def main(argv=None) -> int:
     print(f"growth exponent d log(time)/d log(M) over M = {sc['nodes_fitted']}: {slopes_text(sc)}; "
           f"target slope ~1 (<= 1.2): {_verdict(sc['linear_met'])}; M = 100 within 0.3 s: "
           f"{_verdict(sc['target_M100_under_1s'])}")
-    print("split (under cProfile, scaled to the wall time): eval = RodModel.evaluate, linalg = cholesky+solve+ldlt, "
+    print("split (under cProfile, scaled to the wall time): loop = the compiled Newton and corrector, "
+          "eval = RodModel.evaluate, linalg = cholesky+solve+ldlt, "
           "eig = lowest_modes+lowest_eigenpairs, other = the rest")
     for n in report["observations"]:
         print("-", n)

@@ -82,7 +82,22 @@ def compile_kernels() -> dict:
             hinge_bending_energy(xp, plate.mesh.triangles, plate.mesh.hinge_triangles, plate.hinge_stiffness,
                                  gradient=gradient, hessian=hessian)
 
+    def solvers():
+        # the compiled Newton load step and pseudo-arclength corrector of the rod family
+        # (ddg.solve.compiled_newton): one specialisation serves the rod and the Sadowsky ribbons
+        from .solve.arclength import ArclengthTracer
+        from .solve.newton import NewtonOptions, newton
+        from .solve.state import State
+
+        model = RodModel(strip, 9)
+        compression = 0.3 * strip.length
+        q = model.apply_clamps(model.buckled_guess(compression), compression, 0.0)
+        result = newton(model, q, NewtonOptions())
+        start = State(result.q, result.evaluation, compression, 0.0, True)
+        ArclengthTracer(model, NewtonOptions()).trace(start, max_points=1)
+
     timed("models", models)
+    timed("compiled solvers", solvers)
     timed("array interfaces", arrays)
     return timings
 

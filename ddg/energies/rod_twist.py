@@ -7,15 +7,18 @@ the curvatures' in rod_curvature; the chain rule to the DOFs is rod_curvature.ad
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from .rod_curvature import TAU
 
 
+@njit(cache=True)
 def discrete_twist(theta: np.ndarray, reference_twist: np.ndarray) -> np.ndarray:
     """tau at the interior nodes (Eq. 5) from the M - 1 twist angles and the M - 2 reference twists."""
     return theta[1:] - theta[:-1] + reference_twist
 
 
+@njit(cache=True)
 def twisting_density(tau, voronoi_lengths, twisting_stiffness):
     """E_t per stencil (n,), its partials in (kappa_n, kappa_g, tau) (n, 3) and second partials (n, 3, 3)."""
     k = twisting_stiffness / voronoi_lengths

@@ -19,6 +19,7 @@ tau = 0 the energy is the rod's bending energy (Eq. 6b), its out-of-plane part a
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from ..geometry.strip import InputError
 from .rod_curvature import KAPPA_N, TAU
@@ -43,6 +44,7 @@ def check_zeta(zeta) -> float:
     return value
 
 
+@njit(cache=True)
 def quartic_twist_term(kappa_n, tau, regularisation):
     """Q = tau^4 / (kn^2 + r^2) and its first and second partial derivatives in (kn, tau).
 
@@ -63,8 +65,13 @@ def sadowsky_density(kappa_n, tau, voronoi_lengths, bending_stiffness, zeta):
     """The quartic term of Eq. (A.5) per stencil, EI2 tau^4 / (kn^2 + (dl / zeta)^2) / (2 dl): its
     values (n,), partials in (kappa_n, kappa_g, tau) (n, 3) and second partials (n, 3, 3). Added to
     the rod's bending and twisting densities (rod_bending, rod_twist) it is the whole of Eq. (A.5);
-    the chain rule to the DOFs is rod_curvature.add_stencil_terms."""
-    zeta = check_zeta(zeta)
+    the chain rule to the DOFs is rod_curvature.add_stencil_terms. zeta is checked (check_zeta)."""
+    return sadowsky_terms(kappa_n, tau, voronoi_lengths, bending_stiffness, check_zeta(zeta))
+
+
+@njit(cache=True)
+def sadowsky_terms(kappa_n, tau, voronoi_lengths, bending_stiffness, zeta):
+    """sadowsky_density for a zeta already checked (the compiled assembly calls it)."""
     a = bending_stiffness / voronoi_lengths
     q, q_k, q_t, q_kk, q_kt, q_tt = quartic_twist_term(kappa_n, tau, voronoi_lengths / zeta)
     energy = 0.5 * a * q
@@ -73,6 +80,7 @@ def sadowsky_density(kappa_n, tau, voronoi_lengths, bending_stiffness, zeta):
     first[:, TAU] = 0.5 * a * q_t
     second = np.zeros((len(energy), 3, 3))
     second[:, KAPPA_N, KAPPA_N] = 0.5 * a * q_kk
-    second[:, KAPPA_N, TAU] = second[:, TAU, KAPPA_N] = 0.5 * a * q_kt
+    second[:, KAPPA_N, TAU] = 0.5 * a * q_kt
+    second[:, TAU, KAPPA_N] = 0.5 * a * q_kt
     second[:, TAU, TAU] = 0.5 * a * q_tt
     return energy, first, second

@@ -45,8 +45,16 @@ class RibbonModel(RodModel):
         super().__init__(strip, nodes)
         self.zeta = check_zeta(DEFAULT_ZETA_OVER_L * strip.length if zeta is None else zeta)
 
+    energy_parts = ("stretching", "bending", "twisting", "sadowsky")
+
+    def quartic_zeta(self) -> float:
+        return self.zeta
+
     def stencil_density(self, kappa_n: np.ndarray, kappa_g: np.ndarray, tau: np.ndarray):
         """The Sadowsky energy (Eq. A.5): the rod's bending and twisting plus the quartic term."""
         parts, first, second = super().stencil_density(kappa_n, kappa_g, tau)
         e_q, f_q, s_q = sadowsky_density(kappa_n, tau, self.voronoi_lengths, self.strip.bending_stiffness, self.zeta)
         return {**parts, "sadowsky": float(e_q.sum())}, first + f_q, second + s_q
+
+
+RibbonModel._one_call_density = RibbonModel.stencil_density

@@ -22,6 +22,7 @@ from ..geometry.centerline import Centerline
 from ..geometry.frames import rod_frames
 from ..geometry.strip import Strip
 from .base import BandedModel, Evaluation
+from .rod_assembly import PARTS, rod_energy
 
 __all__ = ["RodModel", "Evaluation"]
 
@@ -145,13 +146,19 @@ class RodModel(BandedModel):
         """Energy (Eq. 6), gradient and banded Hessian at q, frames transported from the committed
         state: compiled passes over the edges (Eq. 6a) and the stencils (Eqs. 6b, 6c, or the
         ribbon's), written straight into the gradient and the band."""
+        args = self.assembly_args()
+        hessian = hessian and gradient
+        if args is not None:
+            grad, band = self._accumulators(gradient, hessian)
+            parts, frames = rod_energy(np.ascontiguousarray(q, dtype=float), self.committed_frames(), args,
+                                       gradient, hessian, grad, band)
+            return self.compiled_evaluation(parts, grad, band, frames, gradient, hessian)
         x = q[self.node_dofs]
         theta = q[self.theta_dofs]
         t, d1, m1, m2, m_ref = rod_frames(x, self._tangents, self._d1, theta, self._ref_twist)
         kappa_n, kappa_g = material_curvatures(x, m1, m2)
         tau = discrete_twist(theta, m_ref)
         parts, first, second = self.stencil_density(kappa_n, kappa_g, tau)
-        hessian = hessian and gradient
         n = self.n_dof
         grad, band = self._accumulators(gradient, hessian)
         stretching = add_edge_terms(x, self._edge_nodes, self.rest_edge_lengths, self.stretch_stiffness,
@@ -165,6 +172,46 @@ class RodModel(BandedModel):
             parts.update(self.coupled_terms(q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian))
         return self._evaluation({"stretching": float(stretching), **parts}, grad, band, gradient, hessian,
                                 frames=(t, d1, m_ref))
+
+    #: The parts of the energy that rod_assembly.rod_energy computes for this class, in its order.
+    energy_parts = PARTS[:3]
+
+    def assembly_args(self):
+        """The constants of the one-call assembly (ddg.models.rod_assembly.rod_energy) where the
+        model's energy is the rod's, Eq. (6), with no term a subclass adds and evaluate not
+        overridden (the compiled Newton loop calls rod_energy, not evaluate); else None (the model
+        is assembled piece by piece, below). Cached on the model."""
+        cached = getattr(self, "_assembly_args", None)
+        if cached is None:
+            cls = type(self)
+            if (cls.stencil_density is not cls._one_call_density or cls.coupled_terms is not RodModel.coupled_terms
+                    or cls.fuses_stencil_terms or cls.evaluate is not RodModel.evaluate):
+                cached = ()
+            else:
+                s = self.strip
+                cached = (self.node_stride, self._edge_nodes, self.rest_edge_lengths, self.stretch_stiffness,
+                          self.voronoi_lengths, float(s.bending_stiffness), float(s.geodesic_bending_stiffness),
+                          float(s.twisting_stiffness), float(self.quartic_zeta()))
+            self._assembly_args = cached
+        return cached or None
+
+    def compiled_energy(self):
+        """The constants of rod_energy for the compiled Newton loop and corrector
+        (ddg.solve.compiled_newton), or None where the model is assembled piece by piece."""
+        return self.assembly_args()
+
+    def compiled_evaluation(self, parts, grad, band, frames, gradient: bool = True, hessian: bool = True) -> Evaluation:
+        """The Evaluation of rod_energy's output (its parts by name, energy their sum)."""
+        named = {name: float(parts[k]) for k, name in enumerate(self.energy_parts)}
+        return self._evaluation(named, grad, band, gradient, hessian, frames=frames)
+
+    def quartic_zeta(self) -> float:
+        """zeta of the Sadowsky term in the one-call assembly (0: no such term)."""
+        return 0.0
+
+    def committed_frames(self):
+        """The committed (tangents, d1, m_ref) from which trial states' frames are transported."""
+        return (self._tangents, self._d1, self._ref_twist)
 
     #: A model whose energies beyond the rod's share the stencils' chain rule with the rod's own
     #: (`fused_terms` instead of add_stencil_terms and `coupled_terms`: one pass over the stencils).
@@ -256,3 +303,6 @@ class RodModel(BandedModel):
         polar = s.density * s.width * s.thickness * (s.width**2 + s.thickness**2) / 12.0
         mass[self.theta_dofs] = polar * h
         return mass
+
+
+RodModel._one_call_density = RodModel.stencil_density

@@ -29,7 +29,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .extrapolation import ARCLENGTH_PREDICTOR_POINTS, lagrange_weights
-from .newton import settled
+from . import compiled_newton
+from .newton import ROUNDOFF_STALL_FACTOR, settled
 from .state import State
 
 
@@ -96,6 +97,8 @@ class ArclengthTracer:
                  tangent: tuple[np.ndarray, float], ds: float) -> State | None:
         """Bordered Newton from the predicted (q, shear); None if it does not converge."""
         model = self.model
+        if self.newton_options.compiled and getattr(model, "compiled_energy", lambda: None)() is not None:
+            return self._correct_compiled(q, shear, compression, anchor, tangent, ds)
         free = model.free
         rate = self._shear_rate(compression)
         t_q, t_w = tangent
@@ -132,6 +135,32 @@ class ArclengthTracer:
             self.newton_iterations += 1
             model.commit(q, ev)
         return None
+
+    def _correct_compiled(self, q, shear, compression, anchor, tangent, ds) -> State | None:
+        """_correct in one compiled call (ddg.solve.compiled_newton.arclength_correct) for a model
+        with a compiled energy; a singular bordered system ends the correction (None) instead of
+        raising."""
+        model = self.model
+        free = model.free
+        args = model.compiled_energy()
+        base = model.clamp_values(compression, 0.0)
+        floor = model.residual_floor()
+        (converged, q, shear, parts, grad, band, frames, pd, factor, corrections) = compiled_newton.arclength_correct(
+            args, np.ascontiguousarray(q, dtype=float), model.committed_frames(), float(shear),
+            (model.bandwidth + 1) * model.n_dof, base, self._shear_rate(compression), model.constrained,
+            np.ascontiguousarray(anchor.q[free]), float(anchor.shear), tangent[0], float(tangent[1]), float(ds),
+            self._weight2, float(self._length), free.start, free.stop, model.residual_scale(), model.length_scale(),
+            max(self.newton_options.residual_tol, floor), self.newton_options.step_tol,
+            ROUNDOFF_STALL_FACTOR * floor, self.options.max_iterations)
+        self.newton_iterations += int(corrections)
+        ev = model.compiled_evaluation(parts, grad, band, frames)
+        if corrections:
+            model.commit(q, ev)
+        if not converged:
+            return None
+        block = model.free_matrix(ev.hessian)  # its factorisation is the one the corrector made
+        block._cholesky, block._cholesky_tried = (factor.T if pd else None), True
+        return State(q, ev, compression, float(shear), bool(pd), int(corrections))
 
     def trace(self, start: State, direction: float = 1.0, tangent: tuple[np.ndarray, float] | None = None,
               shear_range: tuple[float, float] = (-np.inf, np.inf), stop=None,

@@ -131,7 +131,7 @@ def _update(t, j0, j1, c0, c1, chunk):
 
 
 @njit(cache=True)
-def _ldlt_transposed(t, tol, panel, leaf, chunk, blocked_from):
+def ldlt_transposed(t, tol, panel, leaf, chunk, blocked_from):
     """In place on t (n, w), t[j, r] = A[j + r, j]: on return t[j, r] = L[j + r, j] for r >= 1 and
     t[j, 0] = d_j. Returns (number of pivots with |d| <= tol, first such column or -1, column of an
     exactly zero pivot where the elimination stopped or -1)."""
@@ -152,8 +152,8 @@ def _ldlt_transposed(t, tol, panel, leaf, chunk, blocked_from):
 
 
 @njit(cache=True)
-def _solve_transposed(t, x):
-    """x (n, k) overwritten with A^-1 x, A = L D L^T from _ldlt_transposed's output t."""
+def solve_transposed(t, x):
+    """x (n, k) overwritten with A^-1 x, A = L D L^T from ldlt_transposed's output t."""
     n, w = t.shape
     u = w - 1
     k = x.shape[1]
@@ -177,7 +177,7 @@ def _solve_transposed(t, x):
 
 
 @njit(cache=True)
-def _solve_transposed_1(t, x):
+def solve_transposed_1(t, x):
     """x (n,) overwritten with A^-1 x (one right-hand side: the backward dot products with four partial
     sums, so that they do not wait on one another)."""
     n, w = t.shape
@@ -229,7 +229,7 @@ class BandLDLT:
         diag_max = float(np.max(diag, initial=0.0, where=np.isfinite(diag)))  # a NaN pivot is caught below
         self.tolerance = n * np.finfo(float).eps * diag_max
         self._t = np.array(band.T, order="C", copy=True)  # (n, w), t[j, r] = A[j + r, j]
-        count, first, stop = (_ldlt_transposed(self._t, self.tolerance, PANEL, LEAF, CHUNK, BLOCKED_FROM)
+        count, first, stop = (ldlt_transposed(self._t, self.tolerance, PANEL, LEAF, CHUNK, BLOCKED_FROM)
                                if n else (0, -1, -1))
         self.d = self._t[:, 0].copy()
         self.stopped_at = None if stop < 0 else int(stop)
@@ -283,8 +283,8 @@ class BandLDLT:
         if rhs.ndim not in (1, 2) or rhs.shape[0] != self.n:
             raise ValueError(f"rhs must have shape ({self.n},) or ({self.n}, k), got {rhs.shape}")
         if rhs.ndim == 1:
-            return _solve_transposed_1(self._t, np.array(rhs, dtype=float, copy=True))
-        return _solve_transposed(self._t, np.array(rhs, dtype=float, order="C", copy=True))
+            return solve_transposed_1(self._t, np.array(rhs, dtype=float, copy=True))
+        return solve_transposed(self._t, np.array(rhs, dtype=float, order="C", copy=True))
 
 
 def band_ldlt(band: np.ndarray) -> BandLDLT:

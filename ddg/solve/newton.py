@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.strip import InputError
+from . import compiled_newton
 
 
 def check_option(owner: str, name: str, value, kind: str, low=None, high=None, *, low_open: bool = False,
@@ -83,6 +84,10 @@ class NewtonOptions:
     # the paper's plate at W/L = 1/6 17.9 -> 14.6 s; the 3 paths that stop anyway (Wunderlich,
     # cross-section) spend 36-62 % more before they stop, retrying without the test.
     contraction_limit: float | None = 0.5
+    # Run a plain Newton step in one compiled call (ddg.solve.compiled_newton) where the model has a
+    # compiled energy (the rod and the Sadowsky ribbons): the same iterations, ~2x less time per step
+    # on the rod (benchmarks/results/rod_path.md). False runs the loop below for every model.
+    compiled: bool = True
 
     def __post_init__(self) -> None:
         def c(name, *args, **kw):
@@ -95,6 +100,7 @@ class NewtonOptions:
         c("give_up_after", "int", 1, 1000, allow_none=True)
         c("give_up_ratio", "float", 0.0, 1.0, low_open=True)
         c("contraction_limit", "float", 0.0, 1.0, low_open=True, allow_none=True)
+        c("compiled", "bool")
 
 
 @dataclass
@@ -140,8 +146,54 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
     return result
 
 
+def _message(outcome: int, options: NewtonOptions, residual: float, residual_tol: float, tiny_steps: int,
+             ratio: float, max_iterations: int) -> str:
+    """NewtonResult.message of an outcome (compiled_newton's codes), for both loops."""
+    if outcome == compiled_newton.STALLED:
+        return (f"stalled at scaled residual {residual:.3g} (tolerance {residual_tol:.3g}): "
+                f"Newton corrections below {options.step_tol:g} for {tiny_steps} iterations")
+    return {compiled_newton.CONVERGED: "", compiled_newton.ROUNDOFF: "converged to round-off",
+            compiled_newton.NON_FINITE: "non-finite gradient",
+            compiled_newton.NOT_CONTRACTING: f"Newton corrections not contracting (ratio {ratio:.3g})",
+            compiled_newton.LINE_SEARCH_FAILED: "line search failed",
+            compiled_newton.NO_PROGRESS: f"no progress in {options.give_up_after} iterations",
+            compiled_newton.NO_CONVERGENCE: f"no convergence in {max_iterations} iterations"}[outcome]
+
+
+def _compiled(model, q, options, evaluation):
+    """newton() for minimize=False in one compiled call (ddg.solve.compiled_newton)."""
+    args = model.compiled_energy()
+    free = model.free
+    ev = evaluation
+    if ev is None or ev.gradient is None or ev.hessian is None or ev.frames is None:
+        ev = model.evaluate(q)
+    residual_tol = max(options.residual_tol, model.residual_floor())
+    noise = ROUNDOFF_STALL_FACTOR * model.residual_floor()
+    give_up = -1 if options.give_up_after is None else options.give_up_after
+    limit = 0.0 if options.contraction_limit is None else options.contraction_limit
+    (outcome, q_end, energy_end, parts, grad, band, frames, iterations, res, pd, factor, accepted, trials, ratio,
+     tiny) = compiled_newton.newton_load_step(
+        args, np.ascontiguousarray(q, dtype=float), model.committed_frames(), ev.energy, np.zeros(0),
+        ev.gradient, ev.hessian.band.reshape(-1), free.start, free.stop, model.residual_scale(),
+        model.length_scale(), residual_tol, options.step_tol, noise, options.max_iterations,
+        options.max_line_search, give_up, options.give_up_ratio, limit)
+    if outcome == compiled_newton.SINGULAR:
+        raise np.linalg.LinAlgError("singular matrix")
+    if accepted:
+        ev = model.compiled_evaluation(parts, grad, band, frames)
+        model.commit(q_end, ev)
+    if outcome != compiled_newton.NON_FINITE:
+        block = model.free_matrix(ev.hessian)  # its factorisation is the one the loop made
+        block._cholesky, block._cholesky_tried = (factor.T if pd else None), True
+    converged = outcome in (compiled_newton.CONVERGED, compiled_newton.ROUNDOFF)
+    message = _message(outcome, options, res, residual_tol, tiny, ratio, options.max_iterations)
+    return NewtonResult(q_end, ev, converged, int(iterations), float(res), bool(pd), message), int(trials)
+
+
 def _newton(model, q, options, minimize, evaluation):
     options = options or NewtonOptions()
+    if options.compiled and not minimize and getattr(model, "compiled_energy", lambda: None)() is not None:
+        return _compiled(model, q, options, evaluation)
     free = model.free
     rscale = model.residual_scale()[free]
     lscale = model.length_scale()[free]
@@ -156,9 +208,12 @@ def _newton(model, q, options, minimize, evaluation):
     noise = ROUNDOFF_STALL_FACTOR * model.residual_floor()
     previous_norm, previous_alpha, slow = None, 1.0, 0
     max_iterations = options.max_iterations * (MINIMIZE_ITERATION_FACTOR if minimize else 1)
+
+    def say(outcome, residual, tiny_steps=0, ratio=0.0):
+        return _message(outcome, options, residual, residual_tol, tiny_steps, ratio, max_iterations)
     for iteration in range(max_iterations + 1):
         if not np.all(np.isfinite(ev.gradient)):
-            return NewtonResult(q, ev, False, iteration, np.inf, pd, "non-finite gradient"), trials
+            return NewtonResult(q, ev, False, iteration, np.inf, pd, say(compiled_newton.NON_FINITE, np.inf)), trials
         r = ev.gradient[free]
         res = float(np.max(np.abs(r / rscale), initial=0.0))
         K = model.free_matrix(ev.hessian)
@@ -185,9 +240,8 @@ def _newton(model, q, options, minimize, evaluation):
             if tiny_steps >= STALL_ITERATIONS and res > 0.5 * stall_residual:
                 if res <= ROUNDOFF_STALL_FACTOR * model.residual_floor():
                     # the residual is round-off: q is the equilibrium to within it
-                    return NewtonResult(q, ev, True, iteration, res, pd, "converged to round-off"), trials
-                stalled = (f"stalled at scaled residual {res:.3g} (tolerance {residual_tol:.3g}): "
-                           f"Newton corrections below {options.step_tol:g} for {tiny_steps} iterations")
+                    return NewtonResult(q, ev, True, iteration, res, pd, say(compiled_newton.ROUNDOFF, res)), trials
+                stalled = say(compiled_newton.STALLED, res, tiny_steps=tiny_steps)
                 return NewtonResult(q, ev, False, iteration, res, pd, stalled), trials
             if tiny_steps == 1:
                 stall_residual = res
@@ -202,7 +256,7 @@ def _newton(model, q, options, minimize, evaluation):
             slow = slow + 1 if theta > options.contraction_limit else 0
             if theta > 1.0 - previous_alpha / 4.0 or slow >= 2:
                 return NewtonResult(q, ev, False, iteration, res, pd,
-                                    f"Newton corrections not contracting (ratio {theta:.3g})"), trials
+                                    say(compiled_newton.NOT_CONTRACTING, res, ratio=theta)), trials
         previous_norm = norm
         alpha = 1.0
         accepted = False
@@ -230,17 +284,17 @@ def _newton(model, q, options, minimize, evaluation):
         if not accepted:
             if tiny_steps and res <= ROUNDOFF_STALL_FACTOR * model.residual_floor():
                 # a correction below step_tol that no step length improves: the residual is noise
-                return NewtonResult(q, ev, True, iteration, res, pd, "converged to round-off"), trials
-            return NewtonResult(q, ev, False, iteration + 1, res, pd, "line search failed"), trials
+                return NewtonResult(q, ev, True, iteration, res, pd, say(compiled_newton.ROUNDOFF, res)), trials
+            failed = say(compiled_newton.LINE_SEARCH_FAILED, res)
+            return NewtonResult(q, ev, False, iteration + 1, res, pd, failed), trials
         if iteration == 0:
             first_residual = res
         if not minimize:
             if options.give_up_after is not None and iteration >= options.give_up_after \
                     and res > options.give_up_ratio * first_residual:
-                return NewtonResult(q, ev, False, iteration + 1, res, pd,
-                                    f"no progress in {options.give_up_after} iterations"), trials
+                return NewtonResult(q, ev, False, iteration + 1, res, pd, say(compiled_newton.NO_PROGRESS, res)), trials
         model.commit(q_try, ev_try)
         q, ev = q_try, ev_try
         previous_alpha = alpha
     res = scaled_residual(model, ev.gradient)
-    return NewtonResult(q, ev, False, max_iterations, res, pd, f"no convergence in {max_iterations} iterations"), trials
+    return NewtonResult(q, ev, False, max_iterations, res, pd, say(compiled_newton.NO_CONVERGENCE, res)), trials

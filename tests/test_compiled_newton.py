@@ -1,0 +1,166 @@
+"""The compiled Newton load step (ddg.solve.compiled_newton, issue 31 item 1) is ddg.solve.newton's
+loop run in one compiled call: same iterations to the same states, same failures with the same
+messages; and its pieces, the one-call assembly of the rod's energy (ddg.models.rod_assembly) and
+LAPACK's band routines called from compiled code (ddg.solve.lapack), agree with what they replace."""
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+import ddg
+from ddg.models.ribbon import RibbonModel
+from ddg.models.rod import RodModel
+from ddg.models.wide_ribbons import SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon
+from ddg.solve.compiled_newton import _solve_indefinite
+from ddg.solve.lapack import band_cholesky, band_cholesky_solve, band_lu_solve
+from ddg.solve.newton import NewtonOptions, newton
+
+SCENE = ddg.Strip.from_ratios(0.05, 0.5)
+
+
+def _random_band(rng, n, bandwidth, shift):
+    """Lower band storage (bandwidth + 1, n) of a symmetric band matrix, and the dense matrix."""
+    a = rng.standard_normal((n, n))
+    a = a + a.T
+    a[np.abs(np.subtract.outer(np.arange(n), np.arange(n))) > bandwidth] = 0.0
+    a += shift * np.eye(n)
+    band = np.zeros((bandwidth + 1, n))
+    for d in range(bandwidth + 1):
+        band[d, : n - d] = np.diagonal(a, -d)
+    return band, a
+
+
+def test_lapack_band_cholesky_and_solve_match_scipy():
+    rng = np.random.default_rng(0)
+    band, a = _random_band(rng, 60, 5, 40.0)
+    t = np.ascontiguousarray(band.T)
+    assert band_cholesky(t)
+    assert np.allclose(t.T, sla.cholesky_banded(band, lower=True), rtol=1e-13, atol=1e-13)
+    b = rng.standard_normal(60)
+    x = b.copy()
+    band_cholesky_solve(t, x)
+    assert np.abs(a @ x - b).max() < 1e-12 * np.abs(b).max()
+
+
+def test_lapack_band_cholesky_refuses_an_indefinite_matrix_and_lu_solves_it():
+    rng = np.random.default_rng(1)
+    band, a = _random_band(rng, 50, 4, 0.0)
+    assert np.linalg.eigvalsh(a)[0] < 0
+    assert not band_cholesky(np.ascontiguousarray(band.T))
+    b = rng.standard_normal(50)
+    x, ok = band_lu_solve(np.ascontiguousarray(band.T), b)
+    assert ok and np.allclose(x, np.linalg.solve(a, b), rtol=1e-10, atol=1e-12)
+    y, ok = _solve_indefinite(np.ascontiguousarray(band.T), np.column_stack([b, 2 * b]))
+    assert ok and np.allclose(y[:, 0], np.linalg.solve(a, b), rtol=1e-10, atol=1e-12)
+    assert np.allclose(y[:, 1], 2 * y[:, 0], rtol=1e-12, atol=1e-14)
+
+
+def test_a_singular_band_is_reported_not_solved():
+    band = np.zeros((3, 6))
+    x, ok = band_lu_solve(np.ascontiguousarray(band.T), np.ones(6))
+    assert not ok
+
+
+@pytest.mark.parametrize("cls", [RodModel, RibbonModel, SanoWadaRibbon])
+def test_the_one_call_assembly_is_the_piecewise_one(cls):
+    """Energy, gradient, Hessian and frames of rod_energy against the model's composition of the
+    same pieces (the path the wide ribbons take) at a random deformed state, frames transported
+    from another: equal to the summation's round-off (measured 4e-16 relative)."""
+    rng = np.random.default_rng(2)
+    model = cls(SCENE, 41)
+    q = model.buckled_guess(0.5 * SCENE.length) + 1e-3 * rng.standard_normal(model.n_dof)
+    model.commit(q)
+    q += 1e-3 * rng.standard_normal(model.n_dof)
+    one = model.evaluate(q)
+    model._assembly_args = ()  # the piecewise composition
+    pieces = model.evaluate(q)
+    assert one.parts.keys() == pieces.parts.keys()
+    assert one.energy == pytest.approx(pieces.energy, rel=1e-14)
+    scale = np.abs(pieces.gradient).max()
+    assert np.abs(one.gradient - pieces.gradient).max() <= 1e-14 * scale
+    assert np.abs(one.hessian.band - pieces.hessian.band).max() <= 1e-14 * np.abs(pieces.hessian.band).max()
+    for a, b in zip(one.frames, pieces.frames):
+        assert np.array_equal(a, b)
+
+
+def test_the_wide_ribbons_are_assembled_piecewise():
+    """A model adding energies beyond Eq. (6) / (A.5) must not take the rod's one-call assembly."""
+    for cls in (TrapezeRibbon, WunderlichRibbon):
+        assert cls(SCENE, 41).compiled_energy() is None
+    for cls in (RodModel, RibbonModel, SanoWadaRibbon):
+        assert cls(SCENE, 41).compiled_energy() is not None
+
+
+def _run(model_name, compiled, resolution):
+    options = ddg.ContinuationOptions(newton=NewtonOptions(compiled=compiled))
+    return ddg.simulate(SCENE, ddg.LoadingProtocol(0.5), model=model_name, resolution=resolution, options=options)
+
+
+@pytest.mark.parametrize("model_name, resolution", [("rod", 60), ("ribbon", 61)])
+def test_the_compiled_loop_takes_the_same_path_as_the_python_loop(model_name, resolution):
+    """The whole default path with its thresholds and branches: the same Newton iterations in every
+    phase of the path, the same thresholds and H_mid.
+
+    The load steps do the same arithmetic (measured: identical states). The corrector's inner
+    product sums in another order than numpy's pairwise sum, so its states differ by round-off
+    (measured 1e-15 L away from folds, 1e-11 L at the fold that gives dW2), and at the fold one
+    convergence test may fall the other way: threshold location took 135 against 136 iterations
+    at M = 60 (110 both at M = 100). Bounds: 1e-9 L on the thresholds (a thousand times the
+    measured 1e-12, a millionth of dW2's bracket) and 2 % on the threshold iterations."""
+    compiled, python = _run(model_name, True, resolution), _run(model_name, False, resolution)
+    a, b = compiled.summary, python.summary
+    assert a["status"] == b["status"] == "complete"
+    assert a["newton_iterations"] == b["newton_iterations"]
+    assert a["newton_iterations_by_phase"] == b["newton_iterations_by_phase"]
+    assert abs(a["threshold_newton_iterations"] - b["threshold_newton_iterations"]) <= \
+        0.02 * b["threshold_newton_iterations"]
+    for key in ("dW1_over_L", "dW2_over_L"):  # the Sadowsky ribbon stays on U here: both None
+        assert (a[key] is None) == (b[key] is None)
+        assert a[key] is None or abs(a[key] - b[key]) < 1e-9
+    h_a, h_b = compiled.column("H_mid_over_L"), python.column("H_mid_over_L")
+    assert len(h_a) == len(h_b) and np.abs(np.asarray(h_a) - np.asarray(h_b)).max() < 1e-9
+    assert len(compiled.branch_rows) == len(python.branch_rows)
+
+
+@pytest.fixture(scope="module")
+def compressed_rod():
+    r = ddg.simulate(SCENE, ddg.LoadingProtocol(0.5, 1e-4, compression_steps=10, shear_steps=1), model="rod",
+                     resolution=40, thresholds=False, branches=False)
+    return r.model, r.final_state
+
+
+@pytest.mark.parametrize("shear_ratio, limit, give_up", [(1e-3, 0.5, 4), (0.2, 0.5, 4), (0.2, None, 4),
+                                                          (0.2, None, None), (0.05, None, 2)])
+def test_a_load_step_ends_the_same_way_in_both_loops(compressed_rod, shear_ratio, limit, give_up):
+    """Converged, not contracting, no progress, no convergence or a failed line search: the same
+    outcome, message, iterations and state, and the same committed frames afterwards."""
+    model, state = compressed_rod
+    q = model.apply_clamps(state.q, state.compression, shear_ratio * SCENE.length)
+    results, frames = [], []
+    for compiled in (True, False):
+        saved = model.save_frames()
+        options = NewtonOptions(contraction_limit=limit, give_up_after=give_up, compiled=compiled)
+        results.append(newton(model, q, options))
+        frames.append(model.save_frames())
+        model.restore_frames(saved)
+    a, b = results
+    assert (a.converged, a.message, a.iterations, a.positive_definite, a.line_search_trials) == \
+        (b.converged, b.message, b.iterations, b.positive_definite, b.line_search_trials)
+    assert np.abs(a.q - b.q).max() <= 1e-12 * SCENE.length
+    assert a.evaluation.energy == pytest.approx(b.evaluation.energy, rel=1e-12)
+    for x, y in zip(*frames):
+        assert np.abs(x - y).max() <= 1e-12
+
+
+def test_the_factor_made_by_the_loop_is_the_stability_tests(compressed_rod):
+    """The converged state's free Hessian carries the Cholesky factor the loop made (item 1: the
+    stability test from the factorisation already made), equal to scipy's."""
+    model, state = compressed_rod
+    q = model.apply_clamps(state.q, state.compression, 1e-3 * SCENE.length)
+    saved = model.save_frames()
+    result = newton(model, q, NewtonOptions())
+    model.restore_frames(saved)
+    assert result.converged and result.positive_definite
+    block = model.free_matrix(result.evaluation.hessian)
+    assert block._cholesky_tried and block._cholesky is not None
+    reference = sla.cholesky_banded(block.band, lower=True)
+    assert np.abs(block._cholesky - reference).max() <= 1e-12 * np.abs(reference).max()

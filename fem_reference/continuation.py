@@ -45,6 +45,8 @@ import numpy as np
 
 from ddg.solve.state import SYMMETRY_TOLERANCE, phase_from_measures
 
+from petsc4py import PETSc
+
 from .shell import NaghdiStrip
 from .solver import ITERATION_PHASES, NewtonFailure, Solver  # noqa: F401  (ITERATION_PHASES re-exported)
 
@@ -84,6 +86,10 @@ class ContinuationOptions:
     #: "secant" (the secant's error is twice the tangent's for equal steps; on the US branch
     #: Newton from it needs 8-16 iterations per step against 7-12), the same states to 1e-8 L.
     predictor: str = "tangent"
+    #: where a substep fails below snap_substep and the descent fails too, trace the branch by
+    #: pseudo-arclength through its fold, down its unstable part and on to the first stable state
+    #: beyond the target (trace_across_fold), once per converged state
+    fold_tracing: bool = True
     #: width of the final bracket of dW1 (the midpoint is reported: within half of it) and of dW2
     #: (its upper end, the first S state found, is reported: within it), units of L; the gold
     #: runs' mesh studies use 1e-4 for both (fem_reference.gold.GOLD_TOLERANCES)
@@ -129,6 +135,9 @@ class Stepper:
         #: ContinuationFailure; the model is then at the last converged state, self.load)
         self.failed_load: np.ndarray | None = None
         self.snaps = 0  # substeps that converged by energy descent past a fold (all phases)
+        self._fold_traced_from: tuple | None = None  # load of the last state a fold trace started from
+        #: the fold traces made: their start and landing dW/L, states traced and outcome
+        self.fold_traces: list[dict] = []
 
     def iteration_breakdown(self) -> dict:
         """summary.json's newton_iterations_by_phase: the solver's Newton iterations per phase
@@ -201,6 +210,18 @@ class Stepper:
                     self.snaps += 1
                 except NewtonFailure:
                     stats.rejected += 1
+            landed = False
+            if (not ok and size <= self.options.snap_substep and self.options.fold_tracing
+                    and trial[0] == current[0] and self._fold_traced_from != tuple(current)):
+                self._fold_traced_from = tuple(current)
+                self.model.set_state(state0)
+                self.model.set_clamp(*current)
+                with self.solver.counting(snap):
+                    its = trace_across_fold(self, trial)
+                ok = landed = its is not None
+                if ok:
+                    stats.snaps += 1
+                    self.snaps += 1
             if not ok:
                 self.model.set_state(state0)
                 self.model.set_clamp(*current)
@@ -215,7 +236,10 @@ class Stepper:
             stats.newton_iterations += its
             stats.substeps += 1
             current = trial
-            self.branch.push(current, self.model.get_state())
+            if landed:  # another branch: the secant history starts again
+                self.branch.reset(current, self.model.get_state())
+            else:
+                self.branch.push(current, self.model.get_state())
             if its <= self.options.easy_iterations:
                 self.substep = size * self.options.max_growth
             else:
@@ -230,6 +254,93 @@ class Stepper:
             self.branch = Branch(list(history.loads), list(history.states))
         else:
             self.branch.reset(load, state)
+
+
+# --- across a fold -----------------------------------------------------------------------------
+#: Pseudo-arclength across a fold (trace_across_fold): first and largest step (the norm of
+#: Solver.arclength_correct, units of L), the step below which the trace is given up, and the most
+#: states it traces. The paper's plate at L/b = 4000, W/L = 1/20 needed 136 states from the fold
+#: of US round a second fold to the stable branch beyond (ddg.solve.continuation.SNAP_POINTS).
+FOLD_TRACE_STEP = (1e-3, 0.02)
+FOLD_TRACE_MIN_STEP = 1e-6
+FOLD_TRACE_POINTS = 200
+
+
+def trace_across_fold(stepper: Stepper, target) -> int | None:
+    """From the converged state at stepper.load, follow the branch by pseudo-arclength in the
+    shear towards target[1]: through its fold (where natural continuation and the descent fail),
+    down the unstable part and, after a second fold, along the stable branch it turns into, to
+    the first stable state (inertia) past target[1] after an unstable one. Newton at `target` from
+    the interpolation of the last two states gives the state the strip snaps to, kept if stable
+    and lower in energy than the fold's state (a snap releases energy). Returns the iterations
+    spent (arclength corrections and the closing Newton's), or None with the model back at the
+    start (recorded in stepper.fold_traces either way)."""
+    model, solver = stepper.model, stepper.solver
+    compression, shear = (float(v) for v in stepper.load)
+    goal = float(target[1])
+    direction = 1.0 if goal >= shear else -1.0
+    start_state, start_shear, start_energy = model.get_state(), shear, model.energy()
+    weight = 1.0 / start_state.size
+    record = {"from_dW_over_L": shear, "to_dW_over_L": goal, "states": 0, "outcome": ""}
+    stepper.fold_traces.append(record)
+    spent = 0
+
+    def give_up(why: str) -> None:
+        record["outcome"] = why
+        model.set_state(start_state)
+        model.set_clamp(compression, start_shear)
+
+    try:
+        t_q, t_w = solver.shear_tangent(compression, shear, weight)
+        t_q, t_w = direction * t_q, direction * t_w
+        ds = FOLD_TRACE_STEP[0]
+        previous = (start_state, shear)
+        seen_unstable = False
+        while record["states"] < FOLD_TRACE_POINTS:
+            anchor, anchor_shear = model.get_state(), shear
+            model.set_state(anchor + ds * t_q)
+            try:
+                its, new_shear = solver.arclength_correct(compression, anchor_shear + ds * t_w, anchor, anchor_shear,
+                                                          (t_q, t_w), ds, weight)
+            except NewtonFailure:
+                spent += solver.last_iterations
+                model.set_state(anchor)
+                model.set_clamp(compression, anchor_shear)
+                ds *= 0.5
+                if ds < FOLD_TRACE_MIN_STEP:
+                    give_up(f"pseudo-arclength step below {FOLD_TRACE_MIN_STEP:g} at dW/L = {anchor_shear:.6f}")
+                    return None
+                continue
+            spent += its
+            record["states"] += 1
+            shear = new_shear
+            stable = solver.negative_eigenvalues() == 0
+            seen_unstable = seen_unstable or not stable
+            if seen_unstable and stable and (shear - goal) * direction >= 0:
+                before, before_shear = previous
+                w = (goal - before_shear) / (shear - before_shear)
+                model.set_state((1.0 - w) * before + w * model.get_state())
+                model.set_clamp(compression, goal)
+                spent += solver.newton()
+                if solver.negative_eigenvalues() != 0 or model.energy() >= start_energy:
+                    give_up(f"the state at dW/L = {goal:.6f} past the second fold is not a stable snap")
+                    return None
+                record["outcome"] = f"landed at dW/L = {goal:.6f}"
+                return spent
+            if abs(shear) > 1.0:
+                give_up(f"left the shear range at dW/L = {shear:.6f}")
+                return None
+            previous = (model.get_state(), shear)
+            new_q, new_w = solver.shear_tangent(compression, shear, weight)
+            sign = 1.0 if weight * float(np.dot(new_q, t_q)) + new_w * t_w >= 0.0 else -1.0
+            t_q, t_w = sign * new_q, sign * new_w
+            if its <= 4:
+                ds = min(FOLD_TRACE_STEP[1], 1.5 * ds)
+        give_up(f"{FOLD_TRACE_POINTS} states traced without a stable state past dW/L = {goal:.6f}")
+        return None
+    except (NewtonFailure, PETSc.Error) as exc:
+        give_up(f"failed: {exc}")
+        return None
 
 
 # --- observation ------------------------------------------------------------------------------

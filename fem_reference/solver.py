@@ -367,6 +367,85 @@ class Solver:
             diff.destroy()
         raise self._fail(opts.max_iterations, f"bordered Newton: no convergence in {opts.max_iterations} iterations")
 
+    # --- pseudo-arclength in the shear ----------------------------------------------------
+    def _shear_derivative(self, compression: float, shear: float) -> tuple[np.ndarray, np.ndarray]:
+        """(R, dR/dW) at the current q: the lifted residual (bc rows q - g) and its derivative in
+        the clamp shear W, exact as the difference over a unit W (R is linear in the clamp values
+        g for a fixed q: the lifting adds K(q) (g - q) on the free rows)."""
+        m = self.model
+        r = self.assemble_residual().getArray().copy()
+        m.set_clamp(compression, shear + 1.0)
+        r_w = self.assemble_residual().getArray().copy() - r
+        m.set_clamp(compression, shear)
+        return r, r_w
+
+    def _solve_two(self, first: np.ndarray, second: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """K^-1 first and K^-1 second with one factorisation of the tangent at the current q."""
+        self.assemble_tangent()
+        self.ksp.setOperators(self.A)
+        rhs, out = self.b.duplicate(), self.b.duplicate()
+        try:
+            rhs.setArray(first)
+            self._factor_and_solve(self.ksp, rhs, out)
+            a = out.getArray().copy()
+            rhs.setArray(second)
+            with self.clock.section("linear solves"):
+                self.ksp.solve(rhs, out)
+            b = out.getArray().copy()
+        finally:
+            rhs.destroy()
+            out.destroy()
+        if self.ksp.getConvergedReason() < 0:
+            raise NewtonFailure("linear solve failed in the pseudo-arclength corrector")
+        return a, b
+
+    def shear_tangent(self, compression: float, shear: float, weight: float) -> tuple[np.ndarray, float]:
+        """Unit tangent (dq, dW) of the branch of equilibria through the current q (dq = -K^-1
+        dR/dW dW) in the norm weight |dq|^2 + dW^2, oriented with dW > 0."""
+        r, r_w = self._shear_derivative(compression, shear)
+        _, dq = self._solve_two(r, r_w)
+        dq = -dq
+        norm = math.sqrt(weight * float(np.dot(dq, dq)) + 1.0)
+        return dq / norm, 1.0 / norm
+
+    def arclength_correct(self, compression: float, shear: float, anchor: np.ndarray, anchor_shear: float,
+                          tangent: tuple[np.ndarray, float], ds: float, weight: float,
+                          max_iterations: int = 12) -> tuple[int, float]:
+        """Bordered Newton for (q, W) from the current q at clamp shear `shear` (Keller's
+        pseudo-arclength, as ddg.solve.arclength): R(q, W) = 0 and weight <q - anchor, t_q> +
+        (W - anchor_shear) t_W = ds. Converged when the correction is below dx_tol (max norm, units
+        of L) or |R| <= atol, with the arclength condition met to 1e-8 ds. Returns (iterations,
+        W); raises NewtonFailure (q is then the last iterate)."""
+        opts, m = self.options, self.model
+        t_q, t_w = tangent
+        m.set_clamp(compression, shear)
+        step = math.inf
+        for it in range(max_iterations + 1):
+            r, r_w = self._shear_derivative(compression, shear)
+            x = m.get_state()
+            arc = weight * float(np.dot(x - anchor, t_q)) + (shear - anchor_shear) * t_w - ds
+            residual = float(np.linalg.norm(r))
+            if not np.isfinite(residual):
+                raise self._fail(it, "pseudo-arclength: residual not finite")
+            if (residual <= opts.atol or step < opts.dx_tol) and abs(arc) <= 1e-8 * ds:
+                self._spent(it, True)
+                return it, shear
+            if it == max_iterations:
+                break
+            try:
+                a, b = self._solve_two(r, r_w)
+            except PETSc.Error as exc:
+                raise self._fail(it, f"factorisation failed in the pseudo-arclength corrector: {exc}") from None
+            d_w = (weight * float(np.dot(a, t_q)) - arc) / (t_w - weight * float(np.dot(b, t_q)))
+            dq = -a - d_w * b
+            step = max(float(np.max(np.abs(dq))), abs(d_w))
+            if not np.isfinite(step):
+                raise self._fail(it + 1, "pseudo-arclength: correction not finite")
+            shear += d_w
+            m.set_state(x + dq)
+            m.set_clamp(compression, shear)
+        raise self._fail(max_iterations, f"pseudo-arclength: no convergence in {max_iterations} iterations")
+
     def descend(self, max_steps: int = 200, sigma: float = 1e-2) -> int:
         """Snap to a stable equilibrium at the current clamp values: Levenberg-Marquardt steps
         (K + sigma diag K) dq = -R, sigma raised until that matrix has no negative eigenvalue

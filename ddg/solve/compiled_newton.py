@@ -25,6 +25,7 @@ from numba import njit
 
 from .band_ldlt import BLOCKED_FROM, CHUNK, LEAF, PANEL, ldlt_transposed, solve_transposed_1
 from .band_scatter import band_matvec
+from .banded import SymmetricBanded
 from ..models.rod_assembly import rod_energy
 from .lapack import band_cholesky, band_cholesky_solve, band_lu_solve
 
@@ -32,8 +33,12 @@ from .lapack import band_cholesky, band_cholesky_solve, band_lu_solve
 (CONVERGED, ROUNDOFF, NON_FINITE, STALLED, NOT_CONTRACTING, LINE_SEARCH_FAILED, NO_PROGRESS, NO_CONVERGENCE,
  SINGULAR) = range(9)
 
-#: SymmetricBanded.LDLT_RESIDUAL: an LDL^T solve is kept below this relative residual, else LU.
-LDLT_RESIDUAL = 1e-8
+#: Iterations with a correction below step_tol after which a residual that has not halved is a
+#: stall (ddg.solve.newton.STALL_ITERATIONS, which is this).
+STALL_ITERATIONS = 3
+
+#: An LDL^T solve is kept below this relative residual, else LU (as SymmetricBanded.solve).
+LDLT_RESIDUAL = SymmetricBanded.LDLT_RESIDUAL
 
 
 @njit(cache=True)
@@ -174,7 +179,7 @@ def newton_load_step(args, q, state, energy0, parts0, grad0, band0, start, stop,
         correction = _max_scaled(dq, ls)
         if correction < step_tol:
             tiny_steps += 1
-            if tiny_steps >= 3 and res > 0.5 * stall_residual:
+            if tiny_steps >= STALL_ITERATIONS and res > 0.5 * stall_residual:
                 outcome = ROUNDOFF if res <= noise else STALLED
                 return (outcome, q, e, parts, grad, band, state, iteration, res, pd, factor, accepted_count, trials,
                         theta, tiny_steps)

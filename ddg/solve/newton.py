@@ -50,8 +50,9 @@ def check_option(owner: str, name: str, value, kind: str, low=None, high=None, *
 #: iteration near a pitchfork), so it may take many more iterations than a load step.
 MINIMIZE_ITERATION_FACTOR = 15
 
-#: Iterations with a correction below step_tol after which a residual that has not halved is a stall.
-STALL_ITERATIONS = 3
+#: Iterations with a correction below step_tol after which a residual that has not halved is a
+#: stall (defined with the compiled loop, which reads it as a constant).
+STALL_ITERATIONS = compiled_newton.STALL_ITERATIONS
 #: A stall (STALL_ITERATIONS corrections below step_tol, the residual not halving) within this
 #: factor of the model's estimated round-off floor of the residual is round-off, hence converged:
 #: the state is fixed to within the correction (< step_tol L) and Newton cannot lower the noise.

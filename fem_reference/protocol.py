@@ -147,6 +147,7 @@ class ShellStepper:
         if self.options.thresholds:
             summary["threshold_newton_iterations"] = breakdown["threshold dW1"] + breakdown["threshold dW2"]
         summary["branch_switch"] = self.branch_switch
+        summary["fold_traces"] = list(self.stepper.fold_traces)  # continuation.trace_across_fold
         summary["threshold_tolerances_over_L"] = {"dW1": self.options.dw1_tolerance, "dW2": self.options.dw2_tolerance}
         summary["wall_time_per_step_s"] = float(np.mean(self.step_times)) if self.step_times else None
         clock = self.solver.clock

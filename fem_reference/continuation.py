@@ -86,9 +86,10 @@ class ContinuationOptions:
     #: "secant" (the secant's error is twice the tangent's for equal steps; on the US branch
     #: Newton from it needs 8-16 iterations per step against 7-12), the same states to 1e-8 L.
     predictor: str = "tangent"
-    #: where a substep fails below snap_substep and the descent fails too, trace the branch by
-    #: pseudo-arclength through its fold, down its unstable part and on to the first stable state
-    #: beyond the target (trace_across_fold), once per converged state
+    #: where a substep of the path (not of a threshold's bisection) fails below snap_substep and the
+    #: descent fails too, trace the branch by pseudo-arclength through its fold, down its unstable
+    #: part and on to the first stable state beyond the target (trace_across_fold), once per
+    #: converged state
     fold_tracing: bool = True
     #: width of the final bracket of dW1 (the midpoint is reported: within half of it) and of dW2
     #: (its upper end, the first S state found, is reported: within it), units of L; the gold
@@ -211,7 +212,7 @@ class Stepper:
                 except NewtonFailure:
                     stats.rejected += 1
             landed = False
-            if (not ok and size <= self.options.snap_substep and self.options.fold_tracing
+            if (not ok and size <= self.options.snap_substep and self.options.fold_tracing and self.phase is None
                     and trial[0] == current[0] and self._fold_traced_from != tuple(current)):
                 self._fold_traced_from = tuple(current)
                 self.model.set_state(state0)
@@ -452,7 +453,16 @@ def locate_dw1(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW1
                     mid = trial
                     break
             stepper.restore(load_a, state_a, history_a)
-            stats = stepper.advance((load_a[0], mid))
+            try:
+                stats = stepper.advance((load_a[0], mid))
+            except ContinuationFailure:
+                # next to the pitchfork U's tangent is nearly singular and Newton may fail there
+                # (the thin shell at L/b = 4000, 0.9e-4 L from it): a secant trial gives way to the
+                # plain bisection, whose points lie farther from the pitchfork
+                if not trials and mid == 0.5 * (a + b):
+                    raise
+                trials = []
+                continue
             iterations += stats.newton_iterations
             if stepper.solver.negative_eigenvalues() == 0:
                 a = mid

@@ -177,8 +177,12 @@ def threshold_steps(shell: ShellStepper, summary: dict) -> list[AfterStep]:
         if shell.first_unstable_u is None or shell.last_stable_u is None:
             return
         (low, low_lambda), (high_shear, high_lambda) = shell.last_stable_u, shell.first_unstable_u
-        found, _ = continuation.locate_dw1(shell.stepper, low, high_shear, shell.options.dw1_tolerance,
-                                           lambdas=(low_lambda, high_lambda))
+        try:
+            found, _ = continuation.locate_dw1(shell.stepper, low, high_shear, shell.options.dw1_tolerance,
+                                               lambdas=(low_lambda, high_lambda))
+        except ContinuationFailure as exc:  # the path stands; dW1 stays null, with the reason
+            summary.setdefault("warnings", []).append(f"dW1 not located (bisection on U): {exc}")
+            return
         summary["dW1_over_L"] = abs(found)
 
     def dw2() -> None:

@@ -273,7 +273,9 @@ def trace_across_fold(stepper: Stepper, target) -> int | None:
     down the unstable part and, after a second fold, along the stable branch it turns into, to
     the first stable state (inertia) past target[1] after an unstable one. Newton at `target` from
     the interpolation of the last two states gives the state the strip snaps to, kept if stable
-    and lower in energy than the fold's state (a snap releases energy). Returns the iterations
+    and lower in energy than the fold's state (a snap releases energy). Where the unstable part
+    meets S instead (a pitchfork of S), Newton at `target` from that junction, kept if in S,
+    stable and lower. Returns the iterations
     spent (arclength corrections and the closing Newton's), or None with the model back at the
     start (recorded in stepper.fold_traces either way)."""
     model, solver = stepper.model, stepper.solver
@@ -317,6 +319,17 @@ def trace_across_fold(stepper: Stepper, target) -> int | None:
             shear = new_shear
             stable = solver.negative_eigenvalues() == 0
             seen_unstable = seen_unstable or not stable
+            if seen_unstable and phase_of(model, model.positions())[0].startswith("S"):
+                # the unstable part of US met S (a pitchfork of S, as the rod's does): Newton at the
+                # target from that junction, on S
+                model.set_clamp(compression, goal)
+                spent += solver.newton()
+                if (solver.negative_eigenvalues() != 0 or model.energy() >= start_energy
+                        or not phase_of(model, model.positions())[0].startswith("S")):
+                    give_up(f"S met at dW/L = {shear:.6f}, but not stable and lower at dW/L = {goal:.6f}")
+                    return None
+                record["outcome"] = f"landed on S at dW/L = {goal:.6f} (met at {shear:.6f})"
+                return spent
             if seen_unstable and stable and (shear - goal) * direction >= 0:
                 before, before_shear = previous
                 w = (goal - before_shear) / (shear - before_shear)

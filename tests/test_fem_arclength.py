@@ -81,3 +81,20 @@ def test_a_trace_that_does_not_snap_leaves_the_model_where_it_started(sheared):
     record = stepper.fold_traces[-1]
     assert record["states"] == 3 and "without a stable state" in record["outcome"]
     assert np.array_equal(model.get_state(), state) and model.clamp == (COMPRESSION, SHEAR)
+
+
+def test_a_failed_fold_trace_is_not_retried_next_to_where_it_failed(sheared):
+    """The shell on 96 x 12 at L/b = 4000 started 8 traces of up to 200 states within 1e-4 L, one
+    per tiny converged substep: after a trace finds no snap, none starts within FOLD_TRACE_RETRY
+    (1e-3 L, dW2's bracket) of it, nor twice from one state."""
+    from fem_reference.continuation import FOLD_TRACE_RETRY
+
+    model, solver, stepper, state = sheared
+    stepper._fold_trace_failed_at, stepper._fold_traced_from = None, None
+    assert stepper.may_trace_fold((COMPRESSION, SHEAR))
+    stepper._fold_traced_from = (COMPRESSION, SHEAR)
+    assert not stepper.may_trace_fold((COMPRESSION, SHEAR))
+    stepper._fold_trace_failed_at = SHEAR
+    assert not stepper.may_trace_fold((COMPRESSION, SHEAR + 0.5 * FOLD_TRACE_RETRY))
+    assert stepper.may_trace_fold((COMPRESSION, SHEAR + 2.0 * FOLD_TRACE_RETRY))
+    stepper._fold_trace_failed_at, stepper._fold_traced_from = None, None

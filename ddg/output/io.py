@@ -127,10 +127,18 @@ def _format(value):
     return value
 
 
+def path_columns(row: dict, leading: tuple[str, ...] = (), trailing: tuple[str, ...] = ()) -> list[str]:
+    """path.csv's header: `leading`, the contract columns, the extras `row` has, then the
+    `trailing` ones not already named (each column once: the shell's trailing columns repeat
+    negative_eigenvalues, one of the extras)."""
+    columns = list(leading) + list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if c in row]
+    return columns + [c for c in trailing if c not in columns]
+
+
 def write_path_csv(path: Path, rows: list[dict], leading: tuple[str, ...] = (), trailing: tuple[str, ...] = ()) -> None:
     """path.csv: the contract columns, then the extras present, then a model's own `trailing` ones
     (branches.csv: leading=("branch",))."""
-    columns = list(leading) + list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if rows and c in rows[0]] + list(trailing)
+    columns = path_columns(rows[0] if rows else {}, leading, trailing)
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(columns)
@@ -331,8 +339,7 @@ class RunFolder:
 
     def append(self, row: dict) -> None:
         if self._columns is None:
-            self._columns = list(self.leading) + list(PATH_COLUMNS) + [c for c in EXTRA_COLUMNS if c in row] \
-                + list(self.trailing)
+            self._columns = path_columns(row, self.leading, self.trailing)
             self._handle = open(self.path / "path.csv", "w", newline="")
             csv.writer(self._handle, lineterminator="\n").writerow(self._columns)
         csv.writer(self._handle, lineterminator="\n").writerow([_format(row.get(c, "")) for c in self._columns])

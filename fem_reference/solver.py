@@ -109,13 +109,30 @@ class NewtonFailure(RuntimeError):
     pass
 
 
+#: Converged to round-off (Solver.newton and Solver.arclength_correct): once the smallest residual
+#: has not halved for ROUNDOFF_STALL_ITERATIONS iterations, a residual below Solver.residual_floor
+#: is round-off and the state an equilibrium to within it. Needed on very thin strips next to a
+#: singular tangent: at L/b = 4000 (96 x 12 elements) near the junction of US+ with S, Newton's
+#: residual stalls at 3.7e-6 while its corrections along the soft mode stay 1e-9 to 1e-8 L, above
+#: dx_tol, so it failed (measured at dW/L 0.4609; the path stopped at 0.4608).
+ROUNDOFF_STALL_ITERATIONS = 3
+#: Solver.residual_floor's factor over its estimate (machine epsilon times the membrane stiffness,
+#: one such force per free DOF, summed in quadrature): 7.5e-6 at L/b = 4000 on 96 x 12 elements,
+#: where the residual stalls at 3.7e-6 (measured). No safety margin beyond that factor 2: next
+#: to the singular tangent a residual r leaves the state off by r / lambda along the soft mode
+#: (with ten times the estimate, Newton at dW/L 0.4612 stopped on a state 1.3e-4 L off S).
+ROUNDOFF_FLOOR_FACTOR = 1.0
+
+
 @dataclass
 class NewtonOptions:
     """Converged when |R| <= atol or |R| <= rtol |R_0| (R in units of D/L: nodal forces of the
     scaled problem) or when a correction was below dx_tol in max norm (units of L: with Newton's
     quadratic convergence the state is then exact to ~dx_tol^2). The residual itself stalls at
     a round-off floor of 1e-8 to 1e-7 (membrane stiffness / bending stiffness ~ (L/b)^2,
-    measured), hence the correction criterion.
+    measured), hence the correction criterion. Next to a singular tangent on very thin strips
+    the corrections along the soft mode stay above dx_tol too; a residual stalled within
+    Solver.residual_floor is then accepted as round-off (ROUNDOFF_STALL_ITERATIONS).
 
     chord_below > 0: after a full Newton iteration whose correction was below chord_below (units of
     L), the next correction reuses that iteration's factorisation (a chord step: one residual
@@ -200,6 +217,14 @@ class Solver:
         #: and those the continuation opens)
         self.clock = PhaseClock()
         self._phase = ("other", "other")
+        #: solves (newton, arclength_correct) accepted as converged to round-off
+        self.roundoff_convergences = 0
+        params = model.params
+        membrane = params.young_modulus * params.thickness / (1.0 - params.membrane_poisson_ratio**2)
+        #: |R| (units of D/L) that round-off alone leaves: machine epsilon times the membrane
+        #: stiffness E t / (1 - nu^2) per free DOF, in quadrature, times ROUNDOFF_FLOOR_FACTOR
+        self.residual_floor = (ROUNDOFF_FLOOR_FACTOR * np.finfo(float).eps * membrane
+                               * math.sqrt(float(np.count_nonzero(model.free))))
 
     # --- counters ----------------------------------------------------------------------
     @contextmanager
@@ -222,6 +247,15 @@ class Solver:
         self.iterations_by_phase[self._phase[0 if converged else 1]] += iterations
         if not converged:
             self.failed_solves += 1
+
+    def _at_roundoff(self, best: list[float], residual: float) -> bool:
+        """Converged to round-off: `residual` within the floor and the smallest residual so far
+        (best, one entry per iteration) not halved over the last ROUNDOFF_STALL_ITERATIONS."""
+        k = ROUNDOFF_STALL_ITERATIONS
+        if residual <= self.residual_floor and len(best) > k and best[-1] > 0.5 * best[-1 - k]:
+            self.roundoff_convergences += 1
+            return True
+        return False
 
     def _fail(self, iterations: int, message: str) -> NewtonFailure:
         self._spent(iterations, False)
@@ -280,6 +314,9 @@ class Solver:
             if it > 0 and (r > opts.divergence_factor * max(r0, opts.atol)):
                 raise self._fail(it, f"residual grew from {r0:.3e} to {r:.3e}")
             best.append(min(r, best[-1]) if best else r)
+            if self._at_roundoff(best, r):
+                self._spent(it, True)
+                return it
             window = opts.stall_window
             if window > 0 and it >= window and best[-1] > 0.5 * best[-1 - window]:
                 raise self._fail(it, f"residual stalled at {best[-1]:.3e} for {window} iterations")
@@ -414,12 +451,14 @@ class Solver:
         """Bordered Newton for (q, W) from the current q at clamp shear `shear` (Keller's
         pseudo-arclength, as ddg.solve.arclength): R(q, W) = 0 and weight <q - anchor, t_q> +
         (W - anchor_shear) t_W = ds. Converged when the correction is below dx_tol (max norm, units
-        of L) or |R| <= atol, with the arclength condition met to 1e-8 ds. Returns (iterations,
+        of L), |R| <= atol or R is round-off (Solver._at_roundoff), with the arclength condition
+        met to 1e-8 ds. Returns (iterations,
         W); raises NewtonFailure (q is then the last iterate)."""
         opts, m = self.options, self.model
         t_q, t_w = tangent
         m.set_clamp(compression, shear)
         step = math.inf
+        best: list[float] = []
         for it in range(max_iterations + 1):
             r, r_w = self._shear_derivative(compression, shear)
             x = m.get_state()
@@ -427,7 +466,9 @@ class Solver:
             residual = float(np.linalg.norm(r))
             if not np.isfinite(residual):
                 raise self._fail(it, "pseudo-arclength: residual not finite")
-            if (residual <= opts.atol or step < opts.dx_tol) and abs(arc) <= 1e-8 * ds:
+            best.append(min(residual, best[-1]) if best else residual)
+            if (residual <= opts.atol or step < opts.dx_tol or self._at_roundoff(best, residual)) \
+                    and abs(arc) <= 1e-8 * ds:
                 self._spent(it, True)
                 return it, shear
             if it == max_iterations:

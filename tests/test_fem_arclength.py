@@ -98,3 +98,37 @@ def test_a_failed_fold_trace_is_not_retried_next_to_where_it_failed(sheared):
     assert not stepper.may_trace_fold((COMPRESSION, SHEAR + 0.5 * FOLD_TRACE_RETRY))
     assert stepper.may_trace_fold((COMPRESSION, SHEAR + 2.0 * FOLD_TRACE_RETRY))
     stepper._fold_trace_failed_at, stepper._fold_traced_from = None, None
+
+
+def test_a_residual_stalled_at_round_off_is_convergence(sheared):
+    """Newton with the residual and correction tests off (atol = rtol = dx_tol = 0) can only end by
+    the round-off acceptance (Solver._at_roundoff, needed next to singular tangents at L/b = 4000):
+    from the state at a neighbouring dW it ends within the floor, on the equilibrium the usual tests find
+    (measured: 1.1e-12 L apart, the stall at 9e-8 within the floor 3e-7; bound 1e-11 L, ten times
+    the measured: both states are round-off apart); with the floor set below the stall
+    the same solve fails after max_iterations instead of accepting."""
+    import dataclasses
+
+    from fem_reference.solver import NewtonFailure
+
+    model, solver, stepper, state = sheared
+    usual = solver.options
+    shear = SHEAR + 1e-3
+    try:
+        expected = _newton_at(model, solver, state, shear)
+        solver.options = dataclasses.replace(usual, atol=0.0, rtol=0.0, dx_tol=0.0)
+        accepted = solver.roundoff_convergences
+        found = _newton_at(model, solver, state, shear)
+        assert solver.roundoff_convergences == accepted + 1
+        assert np.linalg.norm(solver.assemble_residual().array) <= solver.residual_floor
+        assert np.max(np.abs(found - expected)) < 1e-11
+        floor, solver.residual_floor = solver.residual_floor, 0.0
+        try:
+            with pytest.raises(NewtonFailure, match="no convergence"):
+                _newton_at(model, solver, state, shear)
+        finally:
+            solver.residual_floor = floor
+    finally:
+        solver.options = usual
+        model.set_state(state)
+        model.set_clamp(COMPRESSION, SHEAR)

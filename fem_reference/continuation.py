@@ -146,9 +146,12 @@ class Stepper:
         (ITERATION_PHASES; they sum to solver.total_iterations), then counts (not iterations):
         "failed solves" (Newton solves that raised NewtonFailure, every phase), "step halvings"
         and "snaps" (Stepper.advance, every phase), "chord steps" (iterations that reused the
-        last factorisation, NewtonOptions.chord_below; already counted in the phases)."""
+        last factorisation, NewtonOptions.chord_below; already counted in the phases), "round-off
+        convergences" (solves accepted with the residual stalled within the round-off floor,
+        solver.ROUNDOFF_STALL_ITERATIONS)."""
         return {**self.solver.iterations_by_phase, "failed solves": self.solver.failed_solves,
-                "step halvings": self.step_halvings, "snaps": self.snaps, "chord steps": self.solver.chord_steps}
+                "step halvings": self.step_halvings, "snaps": self.snaps, "chord steps": self.solver.chord_steps,
+                "round-off convergences": self.solver.roundoff_convergences}
 
     def may_trace_fold(self, current) -> bool:
         """A fold trace starts once per converged state, and not within FOLD_TRACE_RETRY of the dW

@@ -112,7 +112,8 @@ def test_summary_breaks_down_iterations_and_wall_time_by_phase(tmp_path):
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["converged"], summary["message"]
     by_phase = summary["newton_iterations_by_phase"]
-    assert set(ITERATION_PHASES) | {"failed solves", "step halvings", "snaps", "chord steps"} == set(by_phase)
+    assert set(ITERATION_PHASES) | {"failed solves", "step halvings", "snaps", "chord steps",
+                                    "round-off convergences"} == set(by_phase)
     assert sum(by_phase[p] for p in ITERATION_PHASES) == summary["newton_iterations"]
     for phase in ("compression start", "accepted steps", "threshold dW1", "branch switching"):
         assert by_phase[phase] > 0, (phase, by_phase)

@@ -690,6 +690,48 @@ def finish_path_report(report: dict, provenance: Provenance, scaling, observatio
     return wrote
 
 
+# ---------------------------------------------------------------------------- targets (issue 31)
+def wall_target(name: str, bound: float, r: dict, kinds: tuple[str, ...]) -> dict:
+    """A wall-time target of one run's record (path_timing's keys, split_s): the measured wall
+    time made of the path, threshold location, branch tracing and the rest, and again by kind
+    (split_s's `kinds`, which add up to the wall time)."""
+    stage = r["stage"]
+    path_s = stage["compression"]["time_s"] + stage["shear"]["time_s"]
+    thresholds, branches = r.get("threshold_wall_time_s") or 0.0, r.get("branches_wall_time_s") or 0.0
+    made_of = {"path (compression + shear)": path_s, "threshold location": thresholds, "branch tracing": branches,
+               "rest (set-up, observables, outputs)": r["wall_time_s"] - path_s - thresholds - branches}
+    made_of.update({f"by kind: {k}": r["split_s"][k] for k in kinds})
+    return {"target": name, "bound": bound, "measured": r["wall_time_s"], "unit": "s",
+            "met": bool(r["wall_time_s"] <= bound), "made_of": made_of}
+
+
+def iterations_target(name: str, bound: float, r: dict) -> dict:
+    """Newton iterations per recorded step of one run's record, made of its phases' iterations
+    per recorded step (newton_by_phase)."""
+    steps = r["recorded_steps"]
+    per_step = r["newton_iterations"] / steps
+    return {"target": name, "bound": bound, "measured": per_step, "unit": "its/step",
+            "met": bool(per_step <= bound),
+            "made_of": {f"{phase} ({v['solves']} solves)": v["iterations"] / steps
+                        for phase, v in r["newton_by_phase"].items()}}
+
+
+def targets_markdown(title: str, targets: list[dict]) -> list[str]:
+    """A report section: each target, its bound, the measured figure, met or not, and its parts."""
+    if not targets:
+        return []
+    lines = ["", f"## {title}", "", "| target | bound | measured | met | made of |", "|---|---:|---:|---|---|"]
+    for t in targets:
+        unit = t["unit"]
+        parts = "; ".join(f"{k} {fmt(v, '.2f')}" for k, v in t["made_of"].items() if v is not None)
+        lines.append(f"| {t['target']} | {t['bound']:g} {unit} | {t['measured']:.2f} {unit} | "
+                     f"{'yes' if t['met'] else 'NOT met'} | {parts} |")
+    lines += ["", "made of: the parts of the measured figure, from the same run: seconds (path, threshold location, "
+              "branch tracing, the rest; and again by the kind of work, which adds up to the same wall time) or "
+              "Newton iterations per recorded step by phase."]
+    return lines
+
+
 #: Load average above which other processes are taken to have shared the 2 cores.
 SHARED_LOAD = 1.5
 

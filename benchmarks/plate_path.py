@@ -61,7 +61,8 @@ from benchmarks.common import (PROBE_METHOD, Provenance, after_path_text, best_o
                                shared_machine_note,
                                finish_path_report, fit_slope, fmt, function_key, load_line, machine_section,
                                measure_path, newton_notes, path_slopes, path_timing, ratio, run_in_child, run_notes,
-                               section, slopes_markdown, slopes_text, source_fingerprint, table_section, text_table)
+                               section, slopes_markdown, slopes_text, source_fingerprint, table_section, text_table,
+                               iterations_target, targets_markdown, wall_target)
 
 WIDTH_RATIO = 1.0 / 6.0
 COMPRESSION_RATIO = 0.5
@@ -77,6 +78,10 @@ MIDEDGE_ROWS = [8, 12]
 WALL_TARGET_S = {8: 8.0, 12: 20.0}
 #: issue 29: Newton iterations per recorded step (summary newton_iterations / recorded steps)
 ITERATIONS_PER_STEP_TARGET = 6.0
+#: issue 31 (the paper's plate at W/L = 1/6, full default path with thresholds, best of 3, warm):
+#: wall time by triangles, Newton iterations per recorded step
+ISSUE31_WALL_TARGET_S = {2100: 6.0, 5740: 25.0}
+ISSUE31_ITERATIONS_PER_STEP = 6.0
 #: the compiled kernels each model's evaluate calls (dotted names)
 KERNELS = {
     "plate": ("ddg.energies.stretch.add_edge_terms", "ddg.energies.hinge_bending.add_hinge_terms"),
@@ -352,6 +357,18 @@ def targets(results: list[dict]) -> list[dict]:
     return out
 
 
+def issue31_targets(results: list[dict]) -> list[dict]:
+    """Issue 31's targets for the paper's plate (completed paths only), each with what its figure
+    is made of (benchmarks.common.wall_target, iterations_target)."""
+    ok = [r for r in results if r["status"] == "ok" and r["completed"]]
+    out = [wall_target(f"{r['triangles']} triangles, full default path", ISSUE31_WALL_TARGET_S[r["triangles"]], r,
+                       (*LEVEL1, "other"))
+           for r in ok if r["triangles"] in ISSUE31_WALL_TARGET_S]
+    out += [iterations_target(f"{r['triangles']} triangles, Newton iterations per recorded step",
+                              ISSUE31_ITERATIONS_PER_STEP, r) for r in ok]
+    return out
+
+
 def _target_rows(rows: list[dict]) -> list[tuple]:
     out = []
     for t in rows:
@@ -467,6 +484,7 @@ def markdown_report(report: dict) -> str:
             + " (n/a for other rows); its/step = `summary['newton_iterations']` / recorded steps (rows of path.csv, "
             "the flat start included), threshold location not counted; met = the path completed and the figure is at "
             "or below the target.")
+    lines += targets_markdown("Targets (issue 31)", report.get("issue31_targets", []))
     lines += table_section(
         "Runs", run_header(model), _run_rows(results),
         "triangles = `result.model.mesh.triangle_count`; free DOF = `summary['n_free_dof']`; band = bandwidth of the "
@@ -535,6 +553,8 @@ def build_report(results: list[dict], args, timeout) -> dict:
         "method": PROBE_METHOD,
         "results": results,
     }
+    if model == "plate":
+        report["issue31_targets"] = issue31_targets(results)
     if model == "plate-midedge":
         report["targets"] = targets(results)
         report["targets_definition"] = {

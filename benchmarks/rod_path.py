@@ -42,7 +42,8 @@ from benchmarks.common import (PROBE_METHOD, Provenance, after_path_text, best_o
                                shared_machine_note,
                                finish_path_report, fit_slope, fmt, load_line, machine_section, markdown_table,
                                measure_path, newton_notes, path_slopes, path_timing, run_in_child, run_notes, section,
-                               slopes_markdown, slopes_text, source_fingerprint, text_table)
+                               slopes_markdown, slopes_text, source_fingerprint, targets_markdown, text_table,
+                               iterations_target, wall_target)
 
 WIDTH_RATIO = 0.05
 COMPRESSION_RATIO = 0.5
@@ -57,6 +58,15 @@ CATEGORY_LABELS = {
     "eigen": "eigenvalues (stability.lowest_modes, SymmetricBanded.lowest_eigenpairs)",
     "other": "everything else (continuation/Newton bookkeeping, band copies, observables)",
 }
+
+
+#: Issue 31's targets (best of --repeat, warm cache, idle machine): the solver's wall time of the
+#: full default path (summary wall_time_s, thresholds and branch tracing included) at M = 100 and
+#: 400, the whole process of the command line at M = 100, Newton iterations per recorded step.
+TARGET_SOLVER_S = {100: 0.15, 400: 0.5}
+TARGET_PROCESS_S = 0.8
+TARGET_PROCESS_NODES = 100
+TARGET_ITERATIONS_PER_STEP = 4.0
 
 
 # ---------------------------------------------------------------------------- what is timed
@@ -145,6 +155,52 @@ def measure(nodes: int, compression_steps: int = COMPRESSION_STEPS, shear_steps:
         "H_mid_over_L_exact": exact,
         "H_mid_rel_error": (h - exact) / exact if h is not None else None,
     }
+
+
+def measure_process(nodes: int, repeat: int, timeout: float | None) -> dict:
+    """The whole command-line process of the default rod run at M = nodes, as a user types it
+    (`python -m ddg simulate --model rod --width-ratio 0.05 --compression-ratio 0.5`), timed by
+    this process: best of `repeat`; and `python -c "import ddg.cli"` alone (interpreter start and
+    imports), so that process = imports + the run (numba's cache loads, the solver, the files)."""
+    import subprocess
+    import tempfile
+    import time
+
+    def timed(args) -> float:
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, *args], check=True, capture_output=True, timeout=timeout)
+        return time.perf_counter() - t0
+
+    with tempfile.TemporaryDirectory() as tmp:
+        run = ["-m", "ddg", "simulate", "--model", "rod", "--width-ratio", str(WIDTH_RATIO), "--compression-ratio",
+               str(COMPRESSION_RATIO), "--resolution", str(nodes), "--out", f"{tmp}/run"]
+        timed(run)  # numba's cache index read once before the timed runs
+        process = [timed(run) for _ in range(repeat)]
+        imports = [timed(["-c", "import ddg.cli"]) for _ in range(repeat)]
+    return {"nodes": nodes, "command": "python " + " ".join(run[:-2]), "process_wall_s": min(process),
+            "all_process_wall_s": process, "imports_wall_s": min(imports), "all_imports_wall_s": imports}
+
+
+def issue31_targets(results: list[dict], process: dict | None) -> list[dict]:
+    """Issue 31's targets against the runs, each with what its figure is made of (the same run's
+    record), so that an unmet one says where the rest goes."""
+    ok = {r["nodes"]: r for r in results if r["status"] == "ok" and r["converged"]}
+    kinds = (*CATEGORIES, "other")
+    out = [wall_target(f"M = {m} full default path, solver wall time", bound, ok[m], kinds)
+           for m, bound in TARGET_SOLVER_S.items() if m in ok]
+    if process is not None:
+        r = ok.get(process["nodes"])
+        made_of = {"interpreter start and imports (python -c 'import ddg.cli')": process["imports_wall_s"]}
+        if r is not None:
+            made_of["first simulate call in a fresh process (numba's cache loads, the run)"] = r["first_call_wall_s"]
+            made_of["rest (arguments, files, exit)"] = (process["process_wall_s"] - process["imports_wall_s"]
+                                                        - r["first_call_wall_s"])
+        out.append({"target": f"M = {process['nodes']} whole process ({process['command']})",
+                    "bound": TARGET_PROCESS_S, "measured": process["process_wall_s"], "unit": "s",
+                    "met": process["process_wall_s"] <= TARGET_PROCESS_S, "made_of": made_of})
+    out += [iterations_target(f"M = {m} Newton iterations per recorded step", TARGET_ITERATIONS_PER_STEP, r)
+            for m, r in sorted(ok.items())]
+    return out
 
 
 # ---------------------------------------------------------------------------- reporting
@@ -277,6 +333,7 @@ def markdown_report(report: dict) -> str:
         *shared_machine_note(report),
         f"- accuracy: |rel err| slope against M: {fmt(sc['h_error_slope'], '.2f')} (O(h^2) expects -2)",
     ]
+    lines += targets_markdown("Targets (issue 31)", report.get("issue31_targets", []))
     lines += section("Where the Newton iterations go", report["observations"])
     lines += ["", "Per stage, per phase (`ddg.solve.continuation.PHASES`) and per recorded step: from the probe of "
               "the warm call (a step's time is the wall time from the previous recorded row to this one). The "
@@ -316,6 +373,8 @@ def main(argv=None) -> int:
     parser.add_argument("--out", default="benchmarks/results", help="directory for rod_path.json and rod_path.md")
     parser.add_argument("--timeout", type=float, default=300.0,
                         help="seconds allowed for one run of one M (0: no limit); a run over it is stopped, reported")
+    parser.add_argument("--no-process", action="store_true",
+                        help=f"skip timing the whole command-line process at M = {TARGET_PROCESS_NODES}")
     args = parser.parse_args(argv)
     if args.repeat < 1 or any(m < 5 for m in args.nodes):
         parser.error("--repeat must be >= 1 and every M >= 5")
@@ -330,6 +389,9 @@ def main(argv=None) -> int:
     ]
 
     report = build_report(results, args.repeat, timeout)
+    report["process"] = (measure_process(TARGET_PROCESS_NODES, args.repeat, timeout)
+                         if TARGET_PROCESS_NODES in args.nodes and not args.no_process else None)
+    report["issue31_targets"] = issue31_targets(results, report["process"])
     wrote = finish_path_report(report, provenance, scaling, observations, markdown_report, args.out)
 
     sc = report["scaling"]

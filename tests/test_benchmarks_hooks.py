@@ -175,3 +175,41 @@ def test_the_rod_benchmark_measures_a_small_run_with_everything_its_report_needs
     text = (tmp_path / "rod_path.md").read_text()
     assert "by phase: accepted steps" in text and "by caller" not in text
     assert "measured under cProfile" in text
+    # issue 31's targets: each measured figure is the sum of the parts it is said to be made of
+    as_m100 = dict(rec, nodes=100)
+    process = rod_path.measure_process(100, 1, 300)
+    assert process["process_wall_s"] > process["imports_wall_s"] > 0
+    targets = rod_path.issue31_targets([as_m100], process)
+    assert [t["unit"] for t in targets] == ["s", "s", "its/step"]
+    solver, whole, per_step = targets
+    parts = solver["made_of"]
+    assert math.isclose(sum(v for k, v in parts.items() if not k.startswith("by kind")), solver["measured"])
+    assert math.isclose(sum(v for k, v in parts.items() if k.startswith("by kind")), solver["measured"])
+    assert math.isclose(sum(whole["made_of"].values()), whole["measured"])
+    assert math.isclose(sum(per_step["made_of"].values()), per_step["measured"])
+    report["issue31_targets"] = targets
+    assert "## Targets (issue 31)" in rod_path.markdown_report(report)
+
+
+def test_the_plate_benchmark_states_issue_31s_targets_with_what_each_figure_is_made_of():
+    """On the stored benchmark record (benchmarks/results/plate_path.json): a wall-time target per
+    size the issue names and an iterations target per run, each measured figure the sum of its
+    parts (the path, thresholds, branches and rest; again by kind; iterations by phase)."""
+    import json
+    from pathlib import Path
+
+    from benchmarks import plate_path
+
+    report = json.loads((Path(__file__).parent.parent / "benchmarks/results/plate_path.json").read_text())
+    targets = plate_path.issue31_targets(report["results"])
+    walls = [t for t in targets if t["unit"] == "s"]
+    assert sorted(t["bound"] for t in walls) == sorted(plate_path.ISSUE31_WALL_TARGET_S.values())
+    for t in walls:
+        parts = t["made_of"]
+        assert math.isclose(sum(v for k, v in parts.items() if not k.startswith("by kind")), t["measured"])
+        assert math.isclose(sum(v for k, v in parts.items() if k.startswith("by kind")), t["measured"])
+    for t in targets:
+        if t["unit"] == "its/step":
+            assert math.isclose(sum(t["made_of"].values()), t["measured"])
+    report["issue31_targets"] = targets
+    assert "## Targets (issue 31)" in plate_path.markdown_report(report)

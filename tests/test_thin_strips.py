@@ -85,16 +85,17 @@ def test_the_finer_plate_completes_the_thin_path():
 
 
 #: dW1 of the shell's study runs made before the fold trace and the round-off convergence, which
-#: stopped at the fold of US (64 x 8, 96 x 12): the path up to the fold did not change
-SHELL_DW1_BEFORE = {"N64x8": 0.327527, "N96x12": 0.346595}
+#: stopped at the fold of US (64 x 8, 96 x 12): the path up to the fold did not change; 144 x 18
+#: was first run with both
+SHELL_DW1_BEFORE = {"N64x8": 0.327527, "N96x12": 0.346595, "N144x18": None}
 
 
 @pytest.mark.parametrize("run", sorted(SHELL_DW1_BEFORE))
 def test_the_shells_study_runs_pass_the_fold_too(run):
     """data/fem_gold/dL0.5_W0.05_Lb4000/N*: the shell's study runs complete the path with both
-    thresholds: on 64 x 8 and 96 x 12 a fold trace (fem_reference.continuation.trace_across_fold)
-    lands beyond the fold of US, the midpoint dropping by a finite height (measured 0.2246 -> 0.1565
-    and 0.2400 -> 0.1636 L), and on 96 x 12 Newton passes US+'s junction with S at 0.4609 by the
+    thresholds: on 64 x 8, 96 x 12 and 144 x 18 a fold trace (fem_reference.continuation.trace_across_fold)
+    lands beyond the fold of US, the midpoint dropping by a finite height (measured 0.2246 -> 0.1565,
+    0.2400 -> 0.1636 and 0.2497 -> 0.1676 L), and on 96 x 12 Newton passes US+'s junction with S at 0.4609 by the
     round-off convergence (fem_reference.solver.ROUNDOFF_STALL_ITERATIONS). dW1 is the one of the
     runs that stopped at the fold (bound: the 1e-4 L bisection bracket)."""
     import csv
@@ -107,7 +108,8 @@ def test_the_shells_study_runs_pass_the_fold_too(run):
     fold = summary["fold_traces"][0]["from_dW_over_L"]
     assert summary["dW1_over_L"] < fold < summary["dW2_over_L"]
     assert "landed" in summary["fold_traces"][0]["outcome"]
-    assert summary["dW1_over_L"] == pytest.approx(SHELL_DW1_BEFORE[run], abs=1e-4)
+    if SHELL_DW1_BEFORE[run] is not None:
+        assert summary["dW1_over_L"] == pytest.approx(SHELL_DW1_BEFORE[run], abs=1e-4)
     rows = [r for r in csv.DictReader((folder / "path.csv").open()) if r["stage"] == "shear"]
     last = max((r for r in rows if float(r["dW_over_L"]) <= fold), key=lambda r: float(r["dW_over_L"]))
     first = min((r for r in rows if float(r["dW_over_L"]) > fold), key=lambda r: float(r["dW_over_L"]))

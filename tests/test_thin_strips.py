@@ -116,13 +116,13 @@ def test_the_shells_study_runs_pass_the_fold_too(run):
     assert float(last["H_mid_over_L"]) - float(first["H_mid_over_L"]) > 0.05
 
 
-def test_the_stored_plate_runs_pass_the_fold():
-    """data/plate_gold/dL0.5_W0.05_Lb4000/past_the_fold: on 8 and 12 rows the plate reaches S with
-    both thresholds (dW2 at a fold); 12 rows complete, 8 rows stop beyond their resolved range."""
+def test_the_plates_study_runs_pass_the_fold():
+    """data/plate_gold/dL0.5_W0.05_Lb4000: on 8 and 12 rows the plate reaches S with both
+    thresholds (dW2 at a fold); 12 rows complete, 8 rows stop beyond their resolved range."""
     import json
     from pathlib import Path
 
-    folder = Path(__file__).resolve().parents[1] / "data" / "plate_gold" / "dL0.5_W0.05_Lb4000" / "past_the_fold"
+    folder = Path(__file__).resolve().parents[1] / "data" / "plate_gold" / "dL0.5_W0.05_Lb4000"
     for rows in ("R8", "R12"):
         s = json.loads((folder / rows / "summary.json").read_text())
         assert s["dW1_over_L"] < FOLD_OF_US < s["dW2_over_L"] and s["dW2_located_by"] == "fold"

@@ -812,9 +812,10 @@ def missing_scenes(scenes: list[ReferenceScene]) -> list[str]:
                 stops.setdefault(m.model, []).append(f"{m.label} at dW/L = {shear[-1]['dW_over_L']:.4f}"
                                                      if shear else m.label)
         if stops:
-            out.append(f"{s.name}: stopped runs, at the fold of US where the stable path should snap to S: "
-                       + "; ".join(f"{model} {', '.join(v)}" for model, v in stops.items())
-                       + ". The reference there has dW1 and H_mid up to the fold but no dW2")
+            missing = [q for q in ("dW1", "dW2") if s.reference.threshold(q) is None]
+            out.append(f"{s.name}: stopped runs: " + "; ".join(f"{model} {', '.join(v)}" for model, v in stops.items())
+                       + (f". The reference there has no {' and no '.join(missing)}" if missing else
+                          ". The reference there has dW1 and dW2"))
     midedge = sorted({s.name for s in scenes for m in s.stored if m.model == "plate-midedge"})
     out.append(f"the mid-edge plate has stored runs on {len(midedge)} scenes only ({', '.join(midedge) or 'none'})")
     out.append("data/fem_fine and data/fem_convergence are other meshes of dL0.5_W0.1667 and data/fem_dep another "

@@ -55,7 +55,7 @@ MAP_SCENES = ((1 / 2, 1 / 8, None), (1 / 4, 1 / 8, None), (1 / 2, 1 / 4, None), 
               # Second held-out set, added after the first set had been checked (issue 17): scenes
               # whose references did not exist when the prediction rule's margin was fixed.
               (1 / 4, 1 / 4, None), (1 / 2, 1 / 10, None), (1 / 4, 1 / 10, None),
-              # the thinnest strip of issue 17 (W^2/(bL) = 10): the shell stops at the fold of US there
+              # the thinnest strip of issue 17 (W^2/(bL) = 10): a fold of US the stable path snaps at
               (1 / 2, 1 / 20, 4000.0))
 #: dW1 and dW2 bisection brackets of the gold runs (units of L), a tenth of the smallest change
 #: between meshes of the earlier W/L = 1/6 study (dW2: 0.4336 to 0.4306 from 90 to 120 elements).

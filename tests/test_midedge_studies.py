@@ -96,7 +96,7 @@ def test_midedge_and_fem_thresholds_agree_within_their_combined_error_bars(reque
 
 
 #: The error map's scenes (fem_reference.gold.MAP_SCENES), checked by the same rule where both
-#: studies have the threshold (at L/b = 4000 the shell stops at the fold of US: no dW2).
+#: studies have the threshold (at L/b = 4000 both pass the fold of US since issue 31).
 MAP_SCENES = [("dL0.5_W0.125", 0.5, 1 / 8), ("dL0.25_W0.125", 0.25, 1 / 8), ("dL0.5_W0.25", 0.5, 1 / 4),
               ("dL0.5_W0.05_Lb300", 0.5, 1 / 20), ("dL0.5_W0.1667_Lb300", 0.5, 1 / 6),
               ("dL0.25_W0.25", 0.25, 1 / 4), ("dL0.5_W0.1", 0.5, 1 / 10), ("dL0.25_W0.1", 0.25, 1 / 10),

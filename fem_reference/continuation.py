@@ -487,8 +487,9 @@ def locate_dw1(stepper: Stepper, low: tuple, high_shear: float, tol: float = DW1
                 stats = stepper.advance((load_a[0], mid))
             except ContinuationFailure:
                 # next to the pitchfork U's tangent is nearly singular and Newton may fail there
-                # (the thin shell at L/b = 4000, 0.9e-4 L from it): a secant trial gives way to the
-                # plain bisection, whose points lie farther from the pitchfork
+                # (the thin shell at L/b = 4000, 0.9e-4 L from it, before the solver accepted a
+                # residual stalled at round-off): a secant trial gives way to the plain bisection,
+                # whose points lie farther from the pitchfork
                 if not trials and mid == 0.5 * (a + b):
                     raise
                 trials = []

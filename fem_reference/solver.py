@@ -116,12 +116,6 @@ class NewtonFailure(RuntimeError):
 #: residual stalls at 3.7e-6 while its corrections along the soft mode stay 1e-9 to 1e-8 L, above
 #: dx_tol, so it failed (measured at dW/L 0.4609; the path stopped at 0.4608).
 ROUNDOFF_STALL_ITERATIONS = 3
-#: Solver.residual_floor's factor over its estimate (machine epsilon times the membrane stiffness,
-#: one such force per free DOF, summed in quadrature): 7.5e-6 at L/b = 4000 on 96 x 12 elements,
-#: where the residual stalls at 3.7e-6 (measured). No safety margin beyond that factor 2: next
-#: to the singular tangent a residual r leaves the state off by r / lambda along the soft mode
-#: (with ten times the estimate, Newton at dW/L 0.4612 stopped on a state 1.3e-4 L off S).
-ROUNDOFF_FLOOR_FACTOR = 1.0
 
 
 @dataclass
@@ -222,9 +216,11 @@ class Solver:
         params = model.params
         membrane = params.young_modulus * params.thickness / (1.0 - params.membrane_poisson_ratio**2)
         #: |R| (units of D/L) that round-off alone leaves: machine epsilon times the membrane
-        #: stiffness E t / (1 - nu^2) per free DOF, in quadrature, times ROUNDOFF_FLOOR_FACTOR
-        self.residual_floor = (ROUNDOFF_FLOOR_FACTOR * np.finfo(float).eps * membrane
-                               * math.sqrt(float(np.count_nonzero(model.free))))
+        #: stiffness E t / (1 - nu^2) per free DOF, in quadrature: 7.5e-6 at L/b = 4000 on 96 x 12
+        #: elements, where the residual stalls at 3.7e-6 (measured). No safety factor on top: next
+        #: to the singular tangent a residual r leaves the state off by r / lambda along the soft
+        #: mode (with ten times the estimate, Newton at dW/L 0.4612 stopped 1.3e-4 L off S).
+        self.residual_floor = np.finfo(float).eps * membrane * math.sqrt(float(np.count_nonzero(model.free)))
 
     # --- counters ----------------------------------------------------------------------
     @contextmanager
@@ -252,10 +248,7 @@ class Solver:
         """Converged to round-off: `residual` within the floor and the smallest residual so far
         (best, one entry per iteration) not halved over the last ROUNDOFF_STALL_ITERATIONS."""
         k = ROUNDOFF_STALL_ITERATIONS
-        if residual <= self.residual_floor and len(best) > k and best[-1] > 0.5 * best[-1 - k]:
-            self.roundoff_convergences += 1
-            return True
-        return False
+        return residual <= self.residual_floor and len(best) > k and best[-1] > 0.5 * best[-1 - k]
 
     def _fail(self, iterations: int, message: str) -> NewtonFailure:
         self._spent(iterations, False)
@@ -315,6 +308,7 @@ class Solver:
                 raise self._fail(it, f"residual grew from {r0:.3e} to {r:.3e}")
             best.append(min(r, best[-1]) if best else r)
             if self._at_roundoff(best, r):
+                self.roundoff_convergences += 1
                 self._spent(it, True)
                 return it
             window = opts.stall_window
@@ -467,8 +461,10 @@ class Solver:
             if not np.isfinite(residual):
                 raise self._fail(it, "pseudo-arclength: residual not finite")
             best.append(min(residual, best[-1]) if best else residual)
-            if (residual <= opts.atol or step < opts.dx_tol or self._at_roundoff(best, residual)) \
-                    and abs(arc) <= 1e-8 * ds:
+            usual = residual <= opts.atol or step < opts.dx_tol
+            if (usual or self._at_roundoff(best, residual)) and abs(arc) <= 1e-8 * ds:
+                if not usual:
+                    self.roundoff_convergences += 1
                 self._spent(it, True)
                 return it, shear
             if it == max_iterations:

@@ -56,7 +56,10 @@ MAP_SCENES = ((1 / 2, 1 / 8, None), (1 / 4, 1 / 8, None), (1 / 2, 1 / 4, None), 
               # whose references did not exist when the prediction rule's margin was fixed.
               (1 / 4, 1 / 4, None), (1 / 2, 1 / 10, None), (1 / 4, 1 / 10, None),
               # the thinnest strip of issue 17 (W^2/(bL) = 10): a fold of US the stable path snaps at
-              (1 / 2, 1 / 20, 4000.0))
+              (1 / 2, 1 / 20, 4000.0),
+              # issue 32: a third compression between the paper's two, so that the map covers dL/L
+              # from 1/4 to 1/2 with a middle point (fitting scenes at the paper's widths)
+              (1 / 3, 1 / 20, None), (1 / 3, 1 / 6, None), (1 / 3, 1 / 10, None), (1 / 3, 1 / 3, None))
 #: dW1 and dW2 bisection brackets of the gold runs (units of L), a tenth of the smallest change
 #: between meshes of the earlier W/L = 1/6 study (dW2: 0.4336 to 0.4306 from 90 to 120 elements).
 GOLD_TOLERANCES = (1e-4, 1e-4)

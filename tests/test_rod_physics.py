@@ -145,3 +145,29 @@ def test_compression_lands_on_the_stable_buckled_branch_from_either_side():
     # the straight state at the same compression is an equilibrium but unstable
     straight = _straight_lowest_eigenvalues(RodModel(strip, 50), 0.02, 1)
     assert straight[0] < 0
+
+
+def test_the_eigenpairs_of_an_unstable_state_are_solved_once(monkeypatch):
+    """An unstable state's lowest eigenpair, computed once for its lambda_min, is reused by a later
+    request for the eigenvector on the same Hessian (branch switching, issue 31 item 2): one
+    shift-invert Lanczos, the same eigenvalue and vector; a request for more eigenvalues solves
+    again."""
+    from ddg.solve.banded import SymmetricBanded
+
+    rod = RodModel(ddg.Strip.from_ratios(0.05, 0.5), 60)
+    ea, ei, L = rod.strip.stretching_stiffness, rod.strip.bending_stiffness, rod.strip.length
+    q = rod.rest_state()
+    q[rod.node_dofs] *= 1.0 - 60.0 * ei / L**2 / ea   # past the first Euler load 4 pi^2: unstable
+    ev = rod.evaluate(q)
+    calls = []
+    solve = SymmetricBanded.lowest_eigenpairs
+    monkeypatch.setattr(SymmetricBanded, "lowest_eigenpairs",
+                        lambda self, *a, **k: calls.append(1) or solve(self, *a, **k))
+    lam = lowest_modes(rod, ev.hessian, 1)
+    assert lam[0] < 0 and len(calls) == 1
+    again, vectors = lowest_modes(rod, ev.hessian, 1, vectors=True)
+    assert len(calls) == 1 and again[0] == lam[0] and vectors.shape == (rod.free.stop - rod.free.start, 1)
+    fresh = rod.evaluate(q)   # another evaluation: nothing kept on it
+    w, v = lowest_modes(rod, fresh.hessian, 1, vectors=True)
+    assert len(calls) == 2 and w[0] == lam[0] and np.array_equal(np.abs(v), np.abs(vectors))
+    assert len(lowest_modes(rod, ev.hessian, 2)) == 2 and len(calls) == 3

@@ -279,7 +279,7 @@ def _point_density(eps, k, t, c, modes: CrossSectionModes):
 
 
 @njit(cache=True)
-def _field_kernel(eps, kappa, kappa_g, tau, c_before, c_after, ell, m, s, big_p, p, q, a, big_psi, eb, d, nu,
+def field_kernel(eps, kappa, kappa_g, tau, c_before, c_after, ell, m, s, big_p, p, q, a, big_psi, eb, d, nu,
                   width, h_g, energy, first, second):
     count, n = c_before.shape
     size = 4 + 2 * n
@@ -364,13 +364,13 @@ def field_density(eps, kappa, kappa_g, tau, c_before, c_after, voronoi_lengths, 
     the stencil's strains u = (eps_i, kappa_i, kappa_g_i, tau_i, c^{i-1}_1..n, c^i_1..n): kappa,
     kappa_g, tau the rod's integrated strains (Eqs. 3-5), eps the Voronoi mean stretch,
     c_before/c_after (N, n) the cross-section modes of the stencil's two edges. Compiled
-    (`_field_kernel`, one pass over the stencils)."""
+    (`field_kernel`, one pass over the stencils)."""
     arrays = [np.ascontiguousarray(x, dtype=float) for x in (eps, kappa, kappa_g, tau, c_before, c_after,
                                                               voronoi_lengths)]
     count, n = arrays[4].shape
     size = 4 + 2 * n
     energy, first, second = np.empty(count), np.empty((count, size)), np.empty((count, size, size))
-    _field_kernel(*arrays, modes.m, modes.S, modes.P, modes.p, modes.Q, modes.a, modes.Psi, modes.membrane,
+    field_kernel(*arrays, modes.m, modes.S, modes.P, modes.p, modes.Q, modes.a, modes.Psi, modes.membrane,
                   modes.plate, modes.poisson_ratio, modes.width, modes.constant_hessian, energy, first, second)
     return energy, first, second
 
@@ -390,24 +390,40 @@ def torsion_warping(tau, voronoi_lengths, pair_lengths, stiffness: float):
     Returns the pairs' energies (n - 1,), partials (n - 1, 2) and second partials (n - 1, 2, 2) in
     (tau_i, tau_{i+1}) (integrated twists, Eq. 5), then the two clamp terms' energies (2,),
     partials (2,) and second partials (2,) in tau_0 and tau_{n-1}."""
-    tau = np.asarray(tau, dtype=float)
-    ell = np.asarray(voronoi_lengths, dtype=float)
-    rate = tau / ell
-    a, b = 1.0 / ell[:-1], 1.0 / ell[1:]
-    jump = rate[1:] - rate[:-1]
-    k = stiffness / np.asarray(pair_lengths, dtype=float)
-    energy = 0.5 * k * jump * jump
-    first = np.stack([-k * jump * a, k * jump * b], axis=1)
-    second = np.empty((len(jump), 2, 2))
-    second[:, 0, 0] = k * a * a
-    second[:, 1, 1] = k * b * b
-    second[:, 0, 1] = second[:, 1, 0] = -k * a * b
+    return torsion_warping_terms(np.ascontiguousarray(tau, dtype=float),
+                                 np.ascontiguousarray(voronoi_lengths, dtype=float),
+                                 np.ascontiguousarray(pair_lengths, dtype=float), float(stiffness))
+
+
+@njit(cache=True)
+def torsion_warping_terms(tau, ell, pair_lengths, stiffness):
+    """torsion_warping on float arrays (compiled; the one-call assembly calls it)."""
+    n = tau.shape[0]
+    energy = np.empty(n - 1)
+    first = np.empty((n - 1, 2))
+    second = np.empty((n - 1, 2, 2))
+    for i in range(n - 1):
+        a, b = 1.0 / ell[i], 1.0 / ell[i + 1]
+        jump = tau[i + 1] / ell[i + 1] - tau[i] / ell[i]
+        k = stiffness / pair_lengths[i]
+        energy[i] = 0.5 * k * jump * jump
+        first[i, 0] = -k * jump * a
+        first[i, 1] = k * jump * b
+        second[i, 0, 0] = k * a * a
+        second[i, 1, 1] = k * b * b
+        second[i, 0, 1] = -k * a * b
+        second[i, 1, 0] = -k * a * b
     # the clamps: tau = 0 at s = 0 and L; the clamp point is the clamped edge's midpoint, so the
     # first node is half an edge, l_0 / 2 on the uniform centreline, from it
-    ends = np.array([0, len(tau) - 1])
-    c = stiffness / (0.5 * ell[ends]) / ell[ends] ** 2
-    end_energy = 0.5 * c * tau[ends] ** 2
-    return energy, first, second, end_energy, c * tau[ends], c
+    end_energy = np.empty(2)
+    end_first = np.empty(2)
+    end_second = np.empty(2)
+    for k, end in enumerate((0, n - 1)):
+        c = stiffness / (0.5 * ell[end]) / ell[end] ** 2
+        end_energy[k] = 0.5 * c * tau[end] ** 2
+        end_first[k] = c * tau[end]
+        end_second[k] = c
+    return energy, first, second, end_energy, end_first, end_second
 
 
 def modes_curvature_form(field_dofs: np.ndarray, spacing: float, modes: CrossSectionModes):

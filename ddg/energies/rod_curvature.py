@@ -342,7 +342,7 @@ def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, 
 
 @njit(cache=True)
 def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, node_stride, unit_place, n_dof, grad,
-                                band, want_hessian, tau_gradients):
+                                band, want_hessian, strain_gradients):
     """add_stencil_terms for a density e(eps, kappa_n, kappa_g, tau, u_1 .. u_k) per stencil: eps
     the stencil's Voronoi mean stretch (|e| + |f|) / (|e-bar| + |f-bar|) - 1 (Eq. 2's edges, as
     ddg.energies.stencil_coupling.stencil_stretch), whose edge form is d eps / de = t_e / R,
@@ -350,9 +350,10 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
     of the stencil's block themselves, at block positions unit_place (the cross-section model's
     modes, ddg.models.wide_ribbons.CrossSectionRibbon). first (n, 4 + k), second (n, 4 + k, 4 + k)
     in that order. The first-order parts of all four strains are contracted in edge form before
-    the stencil's 11 x 11 block is formed (one pass, as add_stencil_terms). tau_gradients (n, 11):
-    filled with each stencil's twist gradient over its rod DOFs (for terms coupling neighbouring
-    stencils' twists, `add_twist_pair_terms`), when it has n rows."""
+    the stencil's 11 x 11 block is formed (one pass, as add_stencil_terms). strain_gradients
+    (n, 4, 11): filled with each stencil's gradients of (eps, kappa_n, kappa_g, tau) over its rod
+    DOFs (for terms coupling neighbouring stencils' strains, `add_pair_cross_terms`), when it has
+    n rows."""
     strain, ge, gf, gth, w = _scratch()
     g = np.empty((4, STENCIL_SIZE))
     h11, ee, ef, ff, eth, fth, thth = _contraction_scratch()
@@ -361,7 +362,7 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
     mixed = np.empty(STENCIL_SIZE)
     place = stencil_place(STENCIL_SIZE, node_stride)
     units = unit_place.shape[0]
-    keep_tau = tau_gradients.shape[0] == x.shape[0] - 2
+    keep = strain_gradients.shape[0] == x.shape[0] - 2
     for i in range(x.shape[0] - 2):
         _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1], first[i, 1], first[i, 2],
                  first[i, 3], strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w)
@@ -383,9 +384,10 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
         g[0, 7] = 0.0
         for c in range(3):
             _stencil_gradient(ge, gf, gth, c, g[1 + c])
-        if keep_tau:
-            for a in range(STENCIL_SIZE):
-                tau_gradients[i, a] = g[3, a]
+        if keep:
+            for c in range(4):
+                for a in range(STENCIL_SIZE):
+                    strain_gradients[i, c, a] = g[c, a]
         base = node_stride * i
         for a in range(STENCIL_SIZE):
             grad[base + place[a]] += (first[i, 0] * g[0, a] + first[i, 1] * g[1, a] + first[i, 2] * g[2, a]
@@ -424,26 +426,40 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
 
 
 @njit(cache=True)
-def add_twist_pair_terms(tau_gradients, coupling, node_stride, n_dof, band):
-    """The cross terms of an energy of neighbouring stencils' twists, sum_i E(tau_i, tau_{i+1}):
-    adds coupling[i] (g_i g_{i+1}^T + g_{i+1} g_i^T) to the lower band, g_i stencil i's twist
-    gradient (tau_gradients (n, 11), from add_stretched_stencil_terms) and coupling (n - 1,) the
-    mixed partials d2E / dtau_i dtau_{i+1}. The other parts of the chain rule (the first partials
-    and d2E / dtau_i^2) are per stencil and belong in add_stretched_stencil_terms' first/second."""
+def add_pair_cross_terms(strain_gradients, cross, components, node_stride, n_dof, band):
+    """The cross terms of an energy of neighbouring stencils' strains, sum_i E(s_i, s_{i+1}): adds
+    sum_ab cross[i, a, b] (g_ia g_{i+1,b}^T + g_{i+1,b} g_ia^T) to the lower band, g_ia stencil i's
+    gradient of strain components[a] (strain_gradients (n, 4, 11) in (eps, kappa_n, kappa_g, tau),
+    from add_stretched_stencil_terms) and cross (n - 1, k, k) the mixed partials
+    d2E / ds_ia ds_{i+1,b}. The other parts of the chain rule (the first partials and the second
+    partials within one stencil) are per stencil and belong in add_stretched_stencil_terms'
+    first/second. Used for Eq. V's neighbouring twists (the cross-section model) and Wunderlich's
+    pairs (ddg.energies.wunderlich)."""
     place = stencil_place(STENCIL_SIZE, node_stride)
-    for i in range(tau_gradients.shape[0] - 1):
-        s = coupling[i]
-        if s == 0.0:
-            continue
+    k = components.shape[0]
+    lo_g = np.empty(STENCIL_SIZE)
+    for i in range(strain_gradients.shape[0] - 1):
         lo, hi = node_stride * i, node_stride * (i + 1)  # stencil i + 1 starts one node later
-        for a in range(STENCIL_SIZE):
-            ra = hi + place[a]
-            for b in range(STENCIL_SIZE):
-                rb = lo + place[b]
-                value = s * tau_gradients[i + 1, a] * tau_gradients[i, b]
-                if ra == rb:   # a DOF of both stencils: both products land on the diagonal
-                    band[rb] += 2.0 * value
-                elif ra > rb:
-                    band[(ra - rb) * n_dof + rb] += value
-                else:
-                    band[(rb - ra) * n_dof + ra] += value
+        for b_ in range(k):
+            # h_b = sum_a cross[i, a, b] g_ia: stencil i's side of the products with g_{i+1,b}
+            nonzero = False
+            for c in range(STENCIL_SIZE):
+                total = 0.0
+                for a_ in range(k):
+                    total += cross[i, a_, b_] * strain_gradients[i, components[a_], c]
+                lo_g[c] = total
+                nonzero = nonzero or total != 0.0
+            if not nonzero:
+                continue
+            hi_g = strain_gradients[i + 1, components[b_]]
+            for a in range(STENCIL_SIZE):
+                ra = hi + place[a]
+                for b in range(STENCIL_SIZE):
+                    rb = lo + place[b]
+                    value = hi_g[a] * lo_g[b]
+                    if ra == rb:   # a DOF of both stencils: both products land on the diagonal
+                        band[rb] += 2.0 * value
+                    elif ra > rb:
+                        band[(ra - rb) * n_dof + rb] += value
+                    else:
+                        band[(rb - ra) * n_dof + ra] += value

@@ -35,9 +35,16 @@ from .rod_curvature import STENCIL_SIZE, strain_derivatives
 PAIR_SIZE = STENCIL_SIZE + 4
 
 
+@njit(cache=True)
 def stencil_stretch_values(x: np.ndarray, rest_edge_lengths: np.ndarray) -> np.ndarray:
     """The centreline stretch at the interior nodes, eps_i = (|e| + |f|) / (|e-bar| + |f-bar|) - 1 (n,)."""
-    lengths = np.linalg.norm(x[1:] - x[:-1], axis=1)
+    lengths = np.empty(x.shape[0] - 1)
+    for j in range(x.shape[0] - 1):
+        total = 0.0
+        for k in range(3):
+            d = x[j + 1, k] - x[j, k]
+            total += d * d
+        lengths[j] = np.sqrt(total)
     return (lengths[:-1] + lengths[1:]) / (rest_edge_lengths[:-1] + rest_edge_lengths[1:]) - 1.0
 
 

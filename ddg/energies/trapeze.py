@@ -24,6 +24,7 @@ stretch eps_i of ddg.energies.stencil_coupling.stencil_stretch), per interior no
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 
 def trapeze_coefficients(young_modulus: float, thickness: float, width: float) -> tuple[float, float]:
@@ -31,19 +32,21 @@ def trapeze_coefficients(young_modulus: float, thickness: float, width: float) -
     return (young_modulus * thickness * width**3 / 24.0, young_modulus * thickness * width**5 / 640.0)
 
 
+@njit(cache=True)
 def trapeze_density(eps, tau, voronoi_lengths, coupling, quartic):
     """E_i per stencil (n,), partials in (eps, tau) (n, 2) and second partials (n, 2, 2).
 
     eps: the stencils' centreline stretch; tau: their integrated twist (Eq. 5); coupling, quartic:
-    C3, C5 of trapeze_coefficients."""
+    C3, C5 of trapeze_coefficients. Compiled (the one-call assembly, ddg.models.rod_assembly, calls it)."""
     dl = voronoi_lengths
     t2 = tau * tau
     energy = coupling * eps * t2 / dl + quartic * t2 * t2 / dl**3
-    first = np.empty((len(energy), 2))
+    first = np.empty((energy.shape[0], 2))
     first[:, 0] = coupling * t2 / dl
     first[:, 1] = 2.0 * coupling * eps * tau / dl + 4.0 * quartic * tau * t2 / dl**3
-    second = np.empty((len(energy), 2, 2))
+    second = np.empty((energy.shape[0], 2, 2))
     second[:, 0, 0] = 0.0
-    second[:, 0, 1] = second[:, 1, 0] = 2.0 * coupling * tau / dl
+    second[:, 0, 1] = 2.0 * coupling * tau / dl
+    second[:, 1, 0] = 2.0 * coupling * tau / dl
     second[:, 1, 1] = 2.0 * coupling * eps / dl + 12.0 * quartic * t2 / dl**3
     return energy, first, second

@@ -23,12 +23,17 @@ distance h the factor g_p = g(W (eta_{i+1} - eta_i) / h). Each node's density ta
 g over its one or two pairs, so the energy is sum_i S_i + sum_p (a_p S_i + b_p S_{i+1}) (g_p - 1)
 with weights 1/2 (1 at the first and last interior node). The first sum is the Sadowsky ribbon
 (rod_curvature.add_stencil_terms); this module gives the pair terms, functions of the four strains
-(k2_i, tau_i, k2_{i+1}, tau_{i+1}), assembled by stencil_coupling.add_local_terms (bandwidth 14).
+(k2_i, tau_i, k2_{i+1}, tau_{i+1}), assembled by stencil_coupling.add_local_terms (bandwidth 14) in
+the model's piecewise composition and by rod_curvature.add_pair_cross_terms in the one-call
+assembly (ddg.models.rod_assembly). Compiled (numba): both call the same kernels.
 Where |v| >= 2 the energy is +inf: Newton's line search rejects such a step.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 from .sadowsky import quartic_twist_term
 
@@ -39,32 +44,48 @@ SERIES_BELOW = 0.1
 POLE = 2.0
 
 
-def ruling_factor(v):
-    """g(v) = 2 artanh(v/2) / v and its first two derivatives (arrays like v); inf beyond |v| >= 2."""
-    v = np.asarray(v, dtype=float)
-    g = np.empty_like(v)
-    g1 = np.empty_like(v)
-    g2 = np.empty_like(v)
-    small = np.abs(v) < SERIES_BELOW
-    pole = np.abs(v) >= POLE
-    big = ~small & ~pole
-    # g = sum_k v^(2k) / ((2k + 1) 4^k)
-    vs = v[small]
-    coefficients = [1.0 / ((2 * k + 1) * 4.0**k) for k in range(7)]
-    g[small] = sum(c * vs**(2 * k) for k, c in enumerate(coefficients))
-    g1[small] = sum(2 * k * c * vs**(2 * k - 1) for k, c in enumerate(coefficients) if k >= 1)
-    g2[small] = sum(2 * k * (2 * k - 1) * c * vs**(2 * k - 2) for k, c in enumerate(coefficients) if k >= 1)
-    vb = v[big]
-    a = np.arctanh(0.5 * vb)
-    a1 = 2.0 / (4.0 - vb * vb)
-    a2 = 4.0 * vb / (4.0 - vb * vb) ** 2
-    g[big] = 2.0 * a / vb
-    g1[big] = 2.0 * a1 / vb - 2.0 * a / vb**2
-    g2[big] = 2.0 * a2 / vb - 4.0 * a1 / vb**2 + 4.0 * a / vb**3
-    g[pole], g1[pole], g2[pole] = np.inf, np.nan, np.nan
+#: Coefficients of the series g(v) = sum_k v^(2k) / ((2k + 1) 4^k), k = 0 .. 6.
+_SERIES = np.array([1.0 / ((2 * k + 1) * 4.0**k) for k in range(7)])
+
+
+@njit(cache=True)
+def _ruling_factor_at(v):
+    """g(v), g'(v), g''(v) at one v (ruling_factor)."""
+    if abs(v) >= POLE:
+        return math.inf, math.nan, math.nan
+    if abs(v) < SERIES_BELOW:
+        g, g1, g2 = 0.0, 0.0, 0.0
+        for k in range(_SERIES.shape[0]):
+            c = _SERIES[k]
+            g += c * v ** (2 * k)
+            if k >= 1:
+                g1 += 2 * k * c * v ** (2 * k - 1)
+                g2 += 2 * k * (2 * k - 1) * c * v ** (2 * k - 2)
+        return g, g1, g2
+    a = math.atanh(0.5 * v)
+    a1 = 2.0 / (4.0 - v * v)
+    a2 = 4.0 * v / (4.0 - v * v) ** 2
+    return (2.0 * a / v, 2.0 * a1 / v - 2.0 * a / v**2,
+            2.0 * a2 / v - 4.0 * a1 / v**2 + 4.0 * a / v**3)
+
+
+@njit(cache=True)
+def _ruling_factor_array(v):
+    g, g1, g2 = np.empty_like(v), np.empty_like(v), np.empty_like(v)
+    for i in range(v.shape[0]):
+        g[i], g1[i], g2[i] = _ruling_factor_at(v[i])
     return g, g1, g2
 
 
+def ruling_factor(v):
+    """g(v) = 2 artanh(v/2) / v and its first two derivatives (arrays like v); inf beyond |v| >= 2
+    (series to v^12 below SERIES_BELOW, closed forms above)."""
+    v = np.asarray(v, dtype=float)
+    g, g1, g2 = _ruling_factor_array(np.ascontiguousarray(v.ravel()))
+    return g.reshape(v.shape), g1.reshape(v.shape), g2.reshape(v.shape)
+
+
+@njit(cache=True)
 def ruling_slope(kappa_n, tau, regularisation):
     """eta = tau k / (k^2 + r^2) and its partials (eta_k, eta_t, eta_kk, eta_kt, eta_tt)."""
     d = kappa_n**2 + regularisation**2
@@ -78,6 +99,7 @@ def ruling_slope(kappa_n, tau, regularisation):
     return eta, eta_k, eta_t, eta_kk, eta_kt, eta_tt
 
 
+@njit(cache=True)
 def sadowsky_part(kappa_n, tau, voronoi_lengths, bending_stiffness, twisting_stiffness, regularisation):
     """S = (EI2 k^2 + GJ tau^2 + EI2 tau^4 / (k^2 + r^2)) / (2 dl) per stencil and its partials
     (S_k, S_t, S_kk, S_kt, S_tt): the out-of-plane and twist part of Eq. (A.5)."""
@@ -89,6 +111,7 @@ def sadowsky_part(kappa_n, tau, voronoi_lengths, bending_stiffness, twisting_sti
             half * (2.0 * b + b * q_kk), half * b * q_kt, half * (2.0 * t + b * q_tt))
 
 
+@njit(cache=True)
 def pair_weights(n_stencils: int) -> tuple[np.ndarray, np.ndarray]:
     """(a_p, b_p) of the pairs p = (i, i + 1): each node's S is weighted by the mean of g over its
     pairs, 1/2 per pair, 1 where a node has one pair (the first and last interior node)."""
@@ -99,41 +122,49 @@ def pair_weights(n_stencils: int) -> tuple[np.ndarray, np.ndarray]:
     return a, b
 
 
+@njit(cache=True)
 def wunderlich_pair_density(kappa_n, tau, voronoi_lengths, pair_lengths, width, bending_stiffness,
                             twisting_stiffness, regularisation):
     """The pair terms (a S_i + b S_{i+1}) (g(v) - 1), v = W (eta_{i+1} - eta_i) / h, over the n - 1
     pairs of the n stencils: values (n - 1,), partials (n - 1, 4) and second partials
-    (n - 1, 4, 4) in the strain order (k_i, tau_i, k_{i+1}, tau_{i+1}); and v (n - 1,).
+    (n - 1, 4, 4) in the strain order (k_i, tau_i, k_{i+1}, tau_{i+1}); and v (n - 1,). Past the
+    pole (|v| >= 2) the pair's energy is inf and its derivatives nan.
 
     kappa_n, tau: the stencils' integrated strains; regularisation r = dl / zeta per stencil;
     pair_lengths h: the rest distance between the two nodes (the rest edge length)."""
     s, s_k, s_t, s_kk, s_kt, s_tt = sadowsky_part(kappa_n, tau, voronoi_lengths, bending_stiffness,
                                                   twisting_stiffness, regularisation)
     eta, e_k, e_t, e_kk, e_kt, e_tt = ruling_slope(kappa_n, tau, regularisation)
-    a, b = pair_weights(len(kappa_n))
-    scale = width / pair_lengths
-    v = scale * (eta[1:] - eta[:-1])
-    g, g1, g2 = ruling_factor(v)
-    m = len(v)
-    # the four strains (k_i, t_i, k_j, t_j), j = i + 1
-    big_s = a * s[:-1] + b * s[1:]
-    ds = np.stack([a * s_k[:-1], a * s_t[:-1], b * s_k[1:], b * s_t[1:]], axis=1)
-    dds = np.zeros((m, 4, 4))
-    dds[:, 0, 0], dds[:, 0, 1], dds[:, 1, 1] = a * s_kk[:-1], a * s_kt[:-1], a * s_tt[:-1]
-    dds[:, 2, 2], dds[:, 2, 3], dds[:, 3, 3] = b * s_kk[1:], b * s_kt[1:], b * s_tt[1:]
-    dds[:, 1, 0], dds[:, 3, 2] = dds[:, 0, 1], dds[:, 2, 3]
-    dv = scale[:, None] * np.stack([-e_k[:-1], -e_t[:-1], e_k[1:], e_t[1:]], axis=1)
-    ddv = np.zeros((m, 4, 4))
-    ddv[:, 0, 0], ddv[:, 0, 1], ddv[:, 1, 1] = -e_kk[:-1], -e_kt[:-1], -e_tt[:-1]
-    ddv[:, 2, 2], ddv[:, 2, 3], ddv[:, 3, 3] = e_kk[1:], e_kt[1:], e_tt[1:]
-    ddv[:, 1, 0], ddv[:, 3, 2] = ddv[:, 0, 1], ddv[:, 2, 3]
-    ddv *= scale[:, None, None]
-    gm1 = g - 1.0
-    energy = big_s * gm1
-    with np.errstate(invalid="ignore"):  # past the pole: energy inf, derivatives nan
-        first = ds * gm1[:, None] + (big_s * g1)[:, None] * dv
-        cross = g1[:, None, None] * ds[:, :, None] * dv[:, None, :]
-        second = (dds * gm1[:, None, None] + cross + np.transpose(cross, (0, 2, 1))
-                  + (big_s * g2)[:, None, None] * dv[:, :, None] * dv[:, None, :]
-                  + (big_s * g1)[:, None, None] * ddv)
+    a, b = pair_weights(kappa_n.shape[0])
+    m = kappa_n.shape[0] - 1
+    energy = np.empty(m)
+    first = np.empty((m, 4))
+    second = np.empty((m, 4, 4))
+    v = np.empty(m)
+    ds = np.empty(4)
+    dv = np.empty(4)
+    dds = np.zeros((4, 4))
+    ddv = np.zeros((4, 4))
+    for p in range(m):
+        i, j = p, p + 1
+        scale = width / pair_lengths[p]
+        v[p] = scale * (eta[j] - eta[i])
+        g, g1, g2 = _ruling_factor_at(v[p])
+        big_s = a[p] * s[i] + b[p] * s[j]
+        # the four strains (k_i, t_i, k_j, t_j)
+        ds[0], ds[1], ds[2], ds[3] = a[p] * s_k[i], a[p] * s_t[i], b[p] * s_k[j], b[p] * s_t[j]
+        dds[0, 0], dds[0, 1], dds[1, 1] = a[p] * s_kk[i], a[p] * s_kt[i], a[p] * s_tt[i]
+        dds[2, 2], dds[2, 3], dds[3, 3] = b[p] * s_kk[j], b[p] * s_kt[j], b[p] * s_tt[j]
+        dds[1, 0], dds[3, 2] = dds[0, 1], dds[2, 3]
+        dv[0], dv[1], dv[2], dv[3] = -scale * e_k[i], -scale * e_t[i], scale * e_k[j], scale * e_t[j]
+        ddv[0, 0], ddv[0, 1], ddv[1, 1] = -scale * e_kk[i], -scale * e_kt[i], -scale * e_tt[i]
+        ddv[2, 2], ddv[2, 3], ddv[3, 3] = scale * e_kk[j], scale * e_kt[j], scale * e_tt[j]
+        ddv[1, 0], ddv[3, 2] = ddv[0, 1], ddv[2, 3]
+        gm1 = g - 1.0
+        energy[p] = big_s * gm1
+        for r in range(4):
+            first[p, r] = ds[r] * gm1 + big_s * g1 * dv[r]
+            for c in range(4):
+                second[p, r, c] = (dds[r, c] * gm1 + g1 * (ds[r] * dv[c] + ds[c] * dv[r])
+                                   + big_s * g2 * dv[r] * dv[c] + big_s * g1 * ddv[r, c])
     return energy, first, second, v

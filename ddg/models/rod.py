@@ -22,7 +22,7 @@ from ..geometry.centerline import Centerline
 from ..geometry.frames import rod_frames
 from ..geometry.strip import Strip
 from .base import BandedModel, Evaluation
-from .rod_assembly import PARTS, rod_energy
+from .rod_assembly import PARTS, rod_energy, width_terms
 
 __all__ = ["RodModel", "Evaluation"]
 
@@ -148,11 +148,19 @@ class RodModel(BandedModel):
         ribbon's), written straight into the gradient and the band."""
         args = self.assembly_args()
         hessian = hessian and gradient
-        if args is not None:
-            grad, band = self._accumulators(gradient, hessian)
-            parts, frames = rod_energy(np.ascontiguousarray(q, dtype=float), self.committed_frames(), args,
-                                       gradient, hessian, grad, band)
-            return self.compiled_evaluation(parts, grad, band, frames, gradient, hessian)
+        if args is None:
+            return self.evaluate_piecewise(q, gradient, hessian)
+        grad, band = self._accumulators(gradient, hessian)
+        parts, frames = rod_energy(np.ascontiguousarray(q, dtype=float), self.committed_frames(), args,
+                                   gradient, hessian, grad, band)
+        return self.compiled_evaluation(parts, grad, band, frames, gradient, hessian)
+
+    def evaluate_piecewise(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
+        """evaluate() composed in Python of the same compiled pieces, one call per piece (the
+        strains, the densities, the chain rules of ddg.energies): the reference the one-call
+        assembly is tested against (tests/test_compiled_newton.py), and what a model without a
+        one-call assembly (assembly_args None) evaluates."""
+        hessian = hessian and gradient
         x = q[self.node_dofs]
         theta = q[self.theta_dofs]
         t, d1, m1, m2, m_ref = rod_frames(x, self._tangents, self._d1, theta, self._ref_twist)
@@ -173,27 +181,36 @@ class RodModel(BandedModel):
         return self._evaluation({"stretching": float(stretching), **parts}, grad, band, gradient, hessian,
                                 frames=(t, d1, m_ref))
 
-    #: The parts of the energy that rod_assembly.rod_energy computes for this class, in its order.
+    #: The parts of the energy that rod_assembly.rod_energy computes for this class (names of PARTS).
     energy_parts = PARTS[:3]
 
     def assembly_args(self):
         """The constants of the one-call assembly (ddg.models.rod_assembly.rod_energy) where the
-        model's energy is the rod's, Eq. (6), with no term a subclass adds and evaluate not
-        overridden (the compiled Newton loop calls rod_energy, not evaluate); else None (the model
-        is assembled piece by piece, below). Cached on the model."""
+        model's energy is the rod's, Eq. (6), or a ribbon's whose terms beyond it rod_energy
+        computes (`width_terms` overridden), and evaluate is not overridden (the compiled Newton
+        loop calls rod_energy, not evaluate); else None (the model is assembled piece by piece,
+        below). Cached on the model."""
         cached = getattr(self, "_assembly_args", None)
         if cached is None:
             cls = type(self)
-            if (cls.stencil_density is not cls._one_call_density or cls.coupled_terms is not RodModel.coupled_terms
-                    or cls.fuses_stencil_terms or cls.evaluate is not RodModel.evaluate):
+            own_terms = cls.width_terms is not RodModel.width_terms
+            if cls.evaluate is not RodModel.evaluate or not own_terms and (
+                    cls.stencil_density is not cls._one_call_density or cls.coupled_terms is not RodModel.coupled_terms
+                    or cls.fuses_stencil_terms):
                 cached = ()
             else:
                 s = self.strip
                 cached = (self.node_stride, self._edge_nodes, self.rest_edge_lengths, self.stretch_stiffness,
                           self.voronoi_lengths, float(s.bending_stiffness), float(s.geodesic_bending_stiffness),
-                          float(s.twisting_stiffness), float(self.quartic_zeta()))
+                          float(s.twisting_stiffness), float(self.quartic_zeta()), self.width_terms())
             self._assembly_args = cached
         return cached or None
+
+    def width_terms(self):
+        """The terms beyond Eqs. (6) / (A.5) that rod_energy adds for this model
+        (ddg.models.rod_assembly.width_terms): none for the rod. A subclass with terms of its own
+        (coupled_terms, fused_terms) overrides this with their constants, or is assembled piecewise."""
+        return width_terms()
 
     def compiled_energy(self):
         """The constants of rod_energy for the compiled Newton loop and corrector
@@ -202,7 +219,7 @@ class RodModel(BandedModel):
 
     def compiled_evaluation(self, parts, grad, band, frames, gradient: bool = True, hessian: bool = True) -> Evaluation:
         """The Evaluation of rod_energy's output (its parts by name, energy their sum)."""
-        named = {name: float(parts[k]) for k, name in enumerate(self.energy_parts)}
+        named = {name: float(parts[PARTS.index(name)]) for name in self.energy_parts}
         return self._evaluation(named, grad, band, gradient, hessian, frames=frames)
 
     def quartic_zeta(self) -> float:

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..energies.cross_section import (CrossSectionModes, field_density, modes_curvature_form, torsion_warping,
                                       torsion_warping_stiffness)
-from ..energies.rod_curvature import (STENCIL_SIZE, add_stretched_stencil_terms, add_twist_pair_terms,
+from ..energies.rod_curvature import (STENCIL_SIZE, add_pair_cross_terms, add_stretched_stencil_terms,
                                       material_curvatures)
 from ..energies.sadowsky import check_zeta
 from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_strain_blocks, stencil_stretch,
@@ -42,6 +42,7 @@ from ..energies.wunderlich import POLE, wunderlich_pair_density
 from ..geometry.strip import Strip
 from .ribbon import RibbonModel
 from .rod import RodModel
+from .rod_assembly import CROSS_SECTION, PARTS, TRAPEZE, WUNDERLICH, width_terms
 
 __all__ = ["SanoWadaRibbon", "TrapezeRibbon", "CrossSectionRibbon", "WunderlichRibbon", "sano_wada_zeta",
            "WIDE_RIBBONS"]
@@ -85,6 +86,11 @@ class TrapezeRibbon(RodModel):
     def __init__(self, strip: Strip, nodes: int = 101):
         super().__init__(strip, nodes)
         self.trapeze_coefficients = trapeze_coefficients(strip.young_modulus, strip.thickness, strip.width)
+
+    energy_parts = PARTS[:3] + ("trapeze",)
+
+    def width_terms(self):
+        return width_terms(TRAPEZE, self.trapeze_coefficients)
 
     def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
         eps, eps_grad, eps_hess = stencil_stretch(x, self.rest_edge_lengths)
@@ -131,11 +137,19 @@ class CrossSectionRibbon(RodModel):
         self._curvature_matrix = _symmetric_csr(rows, cols, values, self.n_dof)
 
     fuses_stencil_terms = True
+    energy_parts = PARTS[:3] + ("cross_section", "torsion_warping", "cross_section_bending")
+
+    def width_terms(self):
+        m = self.modes
+        rows, cols, values = modes_curvature_form(self.field_dofs, self.centerline.spacing, m)
+        return width_terms(CROSS_SECTION, (m.membrane, m.plate, m.poisson_ratio, m.width, self.warping_stiffness),
+                           (self.pair_lengths, m.m, m.p, m.a, values), (m.S, m.P, m.Q, m.Psi, m.constant_hessian),
+                           (self._mode_place, rows, cols), self.field_dofs)
 
     def fused_terms(self, q, x, m1, m2, kappa_n, kappa_g, tau, first, second, grad, band, gradient, hessian):
         """The rod's stencil densities (first, second: partials in (kappa_n, kappa_g, tau)), Eq. X
         and Eq. V in one compiled pass over the stencils (rod_curvature.add_stretched_stencil_terms),
-        Eq. V's coupling of neighbouring twists in a second (add_twist_pair_terms); Eq. X' is a
+        Eq. V's coupling of neighbouring twists in a second (add_pair_cross_terms); Eq. X' is a
         constant quadratic form."""
         c = q[self.field_dofs]
         eps = stencil_stretch_values(x, self.rest_edge_lengths)
@@ -155,12 +169,12 @@ class CrossSectionRibbon(RodModel):
             f_uu[:-1, 3, 3] += pair_second[:, 0, 0]
             f_uu[1:, 3, 3] += pair_second[:, 1, 1]
             f_uu[[0, last], 3, 3] += end_second
-            tau_gradients = np.empty((len(tau) if hessian else 0, STENCIL_SIZE))
+            strain_gradients = np.empty((len(tau) if hessian else 0, 4, STENCIL_SIZE))
             add_stretched_stencil_terms(x, m1, m2, self.rest_edge_lengths, f_u, f_uu, self.node_stride,
-                                        self._mode_place, self.n_dof, grad, band, hessian, tau_gradients)
+                                        self._mode_place, self.n_dof, grad, band, hessian, strain_gradients)
             if hessian:
-                add_twist_pair_terms(tau_gradients, np.ascontiguousarray(pair_second[:, 0, 1]), self.node_stride,
-                                     self.n_dof, band)
+                add_pair_cross_terms(strain_gradients, np.ascontiguousarray(pair_second[:, 0:1, 1:2]), np.array([3]),
+                                     self.node_stride, self.n_dof, band)
                 where, values = self._curvature_band
                 band[where] += values
             grad += curvature_force
@@ -258,7 +272,11 @@ class WunderlichRibbon(RibbonModel):
     def __init__(self, strip: Strip, nodes: int = 101, zeta: float | None = None):
         super().__init__(strip, nodes, zeta=check_zeta(sano_wada_zeta(strip) if zeta is None else zeta))
         self.pair_lengths = self.rest_edge_lengths[1:-1]
-        self.largest_ruling_rate = 0.0  # max |W eta'| of the last evaluated state (2 is the pole)
+
+    energy_parts = ("stretching", "bending", "twisting", "sadowsky", "wunderlich")
+
+    def width_terms(self):
+        return width_terms(WUNDERLICH, (self.strip.width,), (self.pair_lengths, self.voronoi_lengths / self.zeta))
 
     def pair_terms(self, kappa_n, tau):
         s = self.strip
@@ -267,7 +285,6 @@ class WunderlichRibbon(RibbonModel):
 
     def coupled_terms(self, q, x, m1, m2, kappa_n, tau, grad, band, gradient, hessian):
         energy, first, second, v = self.pair_terms(kappa_n, tau)
-        self.largest_ruling_rate = float(np.max(np.abs(v))) if len(v) else 0.0
         total = float(energy.sum()) if np.all(np.isfinite(energy)) else math.inf
         if gradient and math.isfinite(total):
             grads, hessians = stencil_strain_blocks(x, m1, m2)

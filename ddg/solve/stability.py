@@ -18,7 +18,14 @@ def lowest_modes(model, hessian, count: int = 1, vectors: bool = False):
 
     The lowest eigenvalue alone of a positive definite Hessian comes from the Cholesky factor
     Newton already computed (ddg.solve.lanczos); other requests, and a Lanczos that does not
-    converge, use ARPACK's shift-invert Lanczos on the scaled matrix."""
+    converge, use ARPACK's shift-invert Lanczos on the scaled matrix, which gives the eigenvectors
+    with the eigenvalues: both are kept on `hessian` (an evaluation's, which nothing changes), so
+    that a later request for them on the same state (branch switching from an unstable state whose
+    lambda_min was recorded, issue 31 item 2) reuses them instead of solving again."""
+    kept = getattr(hessian, "_lowest_modes", None)
+    if kept is not None and kept[0].shape[0] >= count:
+        w, v = kept
+        return (w[:count], v[:, :count]) if vectors else w[:count]
     metric, unit = model.eigenvalue_metric()
     if count == 1 and not vectors:
         K = model.free_matrix(hessian)
@@ -31,7 +38,10 @@ def lowest_modes(model, hessian, count: int = 1, vectors: bool = False):
                 return np.array([lam / unit])
     s = 1.0 / np.sqrt(metric)
     K = model.free_matrix(hessian).scaled(s)
-    if vectors:
-        w, v = K.lowest_eigenpairs(count, vectors=True)
-        return np.asarray(w) / unit, v * s[:, None]
-    return np.atleast_1d(K.lowest_eigenpairs(count)) / unit
+    w, v = K.lowest_eigenpairs(count, vectors=True)   # ARPACK computes the vectors either way
+    w, v = np.atleast_1d(np.asarray(w)) / unit, v * s[:, None]
+    try:
+        hessian._lowest_modes = (w, v)
+    except AttributeError:   # an object that takes no attributes: nothing kept
+        pass
+    return (w, v) if vectors else w

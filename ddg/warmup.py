@@ -5,8 +5,9 @@
 runs each compiled kernel on a tiny model with every argument type the solvers use (energy only,
 gradient, gradient and Hessian; rod, ribbons, plate; the array interfaces used in analysis). numba
 stores the machine code next to the modules (`cache=True`, in `__pycache__`); later processes
-load it (~0.2 s for all kernels) instead of compiling (456 s with an empty cache on a 2-core machine,
-measured, 424 s of it the models). scripts/setup.sh calls it.
+load it (~0.2 s for all kernels) instead of compiling (838 s with an empty cache on a 2-core machine
+beside other runs, measured in the CI of 7337dec; 456 s idle before the wide ribbons' terms joined
+the compiled solvers). scripts/setup.sh calls it.
 """
 from __future__ import annotations
 

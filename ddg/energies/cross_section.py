@@ -426,6 +426,43 @@ def torsion_warping_terms(tau, ell, pair_lengths, stiffness):
     return energy, first, second, end_energy, end_first, end_second
 
 
+@njit(cache=True)
+def add_torsion_warping_partials(f_u, f_uu, pair_first, pair_second, end_first, end_second):
+    """Eq. V's partials per twist (torsion_warping's pairs and clamp terms) added into the
+    stencils' partials f_u (n, k) and f_uu (n, k, k) in u = (eps, kappa_n, kappa_g, tau, ...), the
+    twist at u[3]. The mixed partials of neighbouring twists (pair_second[:, 0, 1]) couple two
+    stencils: rod_curvature.add_pair_cross_terms adds them."""
+    count = f_u.shape[0]
+    for i in range(count - 1):
+        f_u[i, 3] += pair_first[i, 0]
+        f_u[i + 1, 3] += pair_first[i, 1]
+        f_uu[i, 3, 3] += pair_second[i, 0, 0]
+        f_uu[i + 1, 3, 3] += pair_second[i, 1, 1]
+    f_u[0, 3] += end_first[0]
+    f_u[count - 1, 3] += end_first[1]
+    f_uu[0, 3, 3] += end_second[0]
+    f_uu[count - 1, 3, 3] += end_second[1]
+
+
+@njit(cache=True)
+def modes_bending_terms(rows, cols, values, q, n_dof, want_gradient, want_hessian, grad, band):
+    """Eq. X' as the constant quadratic form 1/2 q . K q of modes_curvature_form (K's lower triangle
+    rows >= cols, values): returns the energy, adds K q to grad and K's entries to the flattened
+    lower band (entry (r, c) at band[(r - c) n_dof + c])."""
+    force = np.zeros(n_dof)
+    for k in range(rows.shape[0]):
+        r, c, v = rows[k], cols[k], values[k]
+        force[r] += v * q[c]
+        if r != c:
+            force[c] += v * q[r]
+    if want_gradient:
+        grad += force
+        if want_hessian:
+            for k in range(rows.shape[0]):
+                band[(rows[k] - cols[k]) * n_dof + cols[k]] += values[k]
+    return 0.5 * np.dot(q, force)
+
+
 def modes_curvature_form(field_dofs: np.ndarray, spacing: float, modes: CrossSectionModes):
     """Eq. X': the modes' bending along the strip, (D / 2) int [c'' . R c'' + 2 nu c'' . N c] dx,
     R_ij = int (B_i - <B_i>)(B_j - <B_j>) dy, N_ij = int (B_i - <B_i>) y^(2j - 2) dy, with c'' the

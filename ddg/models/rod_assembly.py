@@ -31,7 +31,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ..energies.cross_section import field_kernel, torsion_warping_terms
+from ..energies.cross_section import (add_torsion_warping_partials, field_kernel, modes_bending_terms,
+                                      torsion_warping_terms)
 from ..energies.rod_bending import bending_density
 from ..energies.rod_curvature import (STENCIL_SIZE, add_pair_cross_terms, add_stencil_terms,
                                       add_stretched_stencil_terms, curvature_rows)
@@ -156,39 +157,20 @@ def _cross_section(q, x, kappa_n, kappa_g, tau, first, second, rest_lengths, vor
     field_kernel(eps, kappa_n, kappa_g, tau, c[:-1], c[1:], voronoi, m, big_s, big_p, p, big_q, a, big_psi,
                   reals[0], reals[1], reals[2], reals[3], h_g, energy, f_u, f_uu)
     pairs, pf, ps, ends, ef, es = torsion_warping_terms(tau, voronoi, pair_lengths, reals[4])
-    # Eq. X': the modes' bending along the strip, 1/2 q . K q with K's lower triangle (rows, cols, form)
-    force = np.zeros(n_dof)
-    for k in range(rows.shape[0]):
-        r, col, v = rows[k], cols[k], form[k]
-        force[r] += v * q[col]
-        if r != col:
-            force[col] += v * q[r]
     parts[6] = energy.sum()
     parts[7] = pairs.sum() + ends.sum()
-    parts[8] = 0.5 * np.dot(q, force)
+    parts[8] = modes_bending_terms(rows, cols, form, q, n_dof, want_gradient, want_hessian, grad, band)
     if not want_gradient:
         return
     # u = (eps, kappa_n, kappa_g, tau, modes): the rod's own partials and Eq. V's per-twist parts join Eq. X's
     f_u[:, 1:4] += first
     f_uu[:, 1:4, 1:4] += second
-    last = count - 1
-    for i in range(count - 1):
-        f_u[i, 3] += pf[i, 0]
-        f_u[i + 1, 3] += pf[i, 1]
-        f_uu[i, 3, 3] += ps[i, 0, 0]
-        f_uu[i + 1, 3, 3] += ps[i, 1, 1]
-    f_u[0, 3] += ef[0]
-    f_u[last, 3] += ef[1]
-    f_uu[0, 3, 3] += es[0]
-    f_uu[last, 3, 3] += es[1]
+    add_torsion_warping_partials(f_u, f_uu, pf, ps, ef, es)
     gradients = np.empty((count if want_hessian else 0, 4, STENCIL_SIZE))
     add_stretched_stencil_terms(x, m1, m2, rest_lengths, f_u, f_uu, node_stride, unit_place, n_dof, grad, band,
                                 want_hessian, gradients)
     if want_hessian:
         add_pair_cross_terms(gradients, ps[:, 0:1, 1:2].copy(), np.array([3]), node_stride, n_dof, band)
-        for k in range(rows.shape[0]):
-            band[(rows[k] - cols[k]) * n_dof + cols[k]] += form[k]
-    grad += force
 
 
 @njit(cache=True)

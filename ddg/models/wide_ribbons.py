@@ -30,7 +30,8 @@ import math
 
 import numpy as np
 
-from ..energies.cross_section import (CrossSectionModes, field_density, modes_curvature_form, torsion_warping,
+from ..energies.cross_section import (CrossSectionModes, add_torsion_warping_partials, field_density,
+                                      modes_bending_terms, modes_curvature_form, torsion_warping,
                                       torsion_warping_stiffness)
 from ..energies.rod_curvature import (STENCIL_SIZE, add_pair_cross_terms, add_stretched_stencil_terms,
                                       material_curvatures)
@@ -101,15 +102,6 @@ class TrapezeRibbon(RodModel):
         return {"trapeze": float(energy.sum())}
 
 
-def _symmetric_csr(rows, cols, values, n: int):
-    """The symmetric sparse matrix whose lower triangle is (rows, cols, values), rows >= cols."""
-    from scipy.sparse import coo_matrix
-
-    lower = coo_matrix((values, (rows, cols)), shape=(n, n)).tocsr()
-    diagonal = coo_matrix((values * (rows == cols), (rows, cols)), shape=(n, n)).tocsr()
-    return (lower + lower.T - diagonal).tocsr()
-
-
 class CrossSectionRibbon(RodModel):
     """The DAR plus its cross-section as a field (ddg.energies.cross_section, Eqs. X, X' and V):
     `modes` DOFs per edge after the twist angle (node_stride 4 + modes), zero on the clamped edges."""
@@ -132,16 +124,14 @@ class CrossSectionRibbon(RodModel):
         self.pair_lengths = self.rest_edge_lengths[1:-1]
         self.bandwidth = 3 * stride + 2  # a pair of stencils spans x_{i-1} .. x_{i+2}: 3 stride + 3 DOFs
         # the modes' bending along the strip, a constant quadratic form in the DOFs (Eq. X')
-        rows, cols, values = modes_curvature_form(self.field_dofs, self.centerline.spacing, self.modes)
-        self._curvature_band = ((rows - cols) * self.n_dof + cols, values)  # distinct entries of the band
-        self._curvature_matrix = _symmetric_csr(rows, cols, values, self.n_dof)
+        self._bending_form = modes_curvature_form(self.field_dofs, self.centerline.spacing, self.modes)
 
     fuses_stencil_terms = True
     energy_parts = PARTS[:3] + ("cross_section", "torsion_warping", "cross_section_bending")
 
     def width_terms(self):
         m = self.modes
-        rows, cols, values = modes_curvature_form(self.field_dofs, self.centerline.spacing, m)
+        rows, cols, values = self._bending_form
         return width_terms(CROSS_SECTION, (m.membrane, m.plate, m.poisson_ratio, m.width, self.warping_stiffness),
                            (self.pair_lengths, m.m, m.p, m.a, values), (m.S, m.P, m.Q, m.Psi, m.constant_hessian),
                            (self._mode_place, rows, cols), self.field_dofs)
@@ -157,29 +147,20 @@ class CrossSectionRibbon(RodModel):
                                           self.modes)
         pairs, pair_first, pair_second, ends, end_first, end_second = torsion_warping(
             tau, self.voronoi_lengths, self.pair_lengths, self.warping_stiffness)
-        curvature_force = self._curvature_matrix @ q
+        bending = modes_bending_terms(*self._bending_form, q, self.n_dof, gradient, hessian, grad, band)
         if gradient:
             # u = (eps, kappa_n, kappa_g, tau, modes): the rod's own partials and Eq. V's per-twist parts join Eq. X's
             f_u[:, 1:4] += first
             f_uu[:, 1:4, 1:4] += second
-            last = len(tau) - 1
-            f_u[:-1, 3] += pair_first[:, 0]
-            f_u[1:, 3] += pair_first[:, 1]
-            f_u[[0, last], 3] += end_first
-            f_uu[:-1, 3, 3] += pair_second[:, 0, 0]
-            f_uu[1:, 3, 3] += pair_second[:, 1, 1]
-            f_uu[[0, last], 3, 3] += end_second
+            add_torsion_warping_partials(f_u, f_uu, pair_first, pair_second, end_first, end_second)
             strain_gradients = np.empty((len(tau) if hessian else 0, 4, STENCIL_SIZE))
             add_stretched_stencil_terms(x, m1, m2, self.rest_edge_lengths, f_u, f_uu, self.node_stride,
                                         self._mode_place, self.n_dof, grad, band, hessian, strain_gradients)
             if hessian:
                 add_pair_cross_terms(strain_gradients, np.ascontiguousarray(pair_second[:, 0:1, 1:2]), np.array([3]),
                                      self.node_stride, self.n_dof, band)
-                where, values = self._curvature_band
-                band[where] += values
-            grad += curvature_force
         return {"cross_section": float(energy.sum()), "torsion_warping": float(pairs.sum() + ends.sum()),
-                "cross_section_bending": 0.5 * float(q @ curvature_force)}
+                "cross_section_bending": float(bending)}
 
     def residual_floor(self) -> float:
         """The rod's floor times (W / h)^2 / 25 where that is above 1: the modes' membrane terms

@@ -20,10 +20,10 @@ where data/midedge_gold has it and the FEM at each mesh of its study (data/fem_g
 data/narrow_limit/Lb*/fem_N*), read, not rerun. Per row, for q in dW1/L, dW2/L: |q - reference|
 (q_error), the reference's error bar (q_ref_error_bar) and their sum (q_bound); for H_mid/L, on
 the reference curve's dW grid inside the run's range and more than THRESHOLD_BAND = 0.02 from the
-reference's dW1 and dW2 (validation.claims; a small shift of a threshold is a large H_mid
-difference there), the largest |H_mid - reference| (H_mid_error), the largest reference error bar
-(H_mid_ref_error_bar) and the largest pointwise sum (H_mid_bound, as validation.estimates
-.Study.mesh_error); the wall time of the run (summary.json wall_time_s: path and thresholds) and a
+reference's dW1 and dW2 and from the run's own (validation.claims; a small shift of a threshold is
+a large H_mid difference there, and the thresholds' own errors are the dW1 and dW2 columns), the
+largest |H_mid - reference| (H_mid_error), the largest reference error bar (H_mid_ref_error_bar)
+and the largest pointwise sum (H_mid_bound, as validation.estimates.Study.mesh_error); the wall time of the run (summary.json wall_time_s: path and thresholds) and a
 reason where a value is missing. A bound is left empty where the run did not complete its path
 (its comparison would cover part of the path only). ddg.advise reads the q_bound columns.
 
@@ -67,10 +67,10 @@ from .estimates import MIDEDGE_GOLD, PLATE_GOLD, Study, away_from, load_study, s
 from .reference import FEM_GOLD, ROOT, gold_name
 
 try:   # the error map's reference scenes beyond the paper's ten (fem_reference.gold; no dolfinx needed)
-    from fem_reference.gold import MAP_SCENES
+    from fem_reference.gold import HELD_OUT_SCENES, MAP_SCENES, NEW_MAP_SCENES
     from fem_reference.gold import scene_name as fem_scene_name
 except ImportError:   # an older fem_reference: the paper's ten and data/narrow_limit only
-    MAP_SCENES, fem_scene_name = (), None
+    MAP_SCENES, NEW_MAP_SCENES, HELD_OUT_SCENES, fem_scene_name = (), (), (), None
 from .studies import COMPRESSIONS, WIDTHS_GOLD
 
 NARROW = ROOT / "data" / "narrow_limit"
@@ -106,8 +106,9 @@ COLUMNS = ("scene", "role", "compression_ratio", "width_ratio", "slenderness", "
 #: quantities, the excluded band, REFERENCE_PATH_SLACK, the reasons). A row of another version is
 #: recomputed (`current`), so that a rule change reaches every row, not only the rows rerun for
 #: another cause. Bump it with any change of those rules. 2: H_mid bounds left out where the
-#: reference stops short (issue 17); rows without the column are from before it.
-RULES_VERSION = "2"
+#: reference stops short (issue 17); rows without the column are from before it. 3: the H_mid
+#: band left out about the run's own thresholds too, not only the reference's (issue 32).
+RULES_VERSION = "3"
 
 
 def _hash(*paths: Path) -> str:
@@ -159,9 +160,13 @@ class ReferenceScene:
 
     @property
     def role(self) -> str:
-        """"held-out" for a width between the paper's (W/L = 1/8, 1/4 of fem_reference.gold.MAP_SCENES):
-        never used by ddg.advise's prediction, only to check it; else "fit"."""
-        return "fit" if any(abs(self.width_ratio - w) < 1e-9 for w in WIDTHS_GOLD) else "held-out"
+        """"held-out" for a scene of fem_reference.gold.HELD_OUT_SCENES (issue 32, named under
+        ddg.advise's rule v3 before their references existed): never used by the prediction, only
+        to check it; else "fit" (the held-out sets of rules v1 and v2, HELD_OUT_FIRST and
+        HELD_OUT_SECOND, were checked then and fit from rule v3 on)."""
+        held = any(abs(self.compression_ratio - c) < 1e-9 and abs(self.width_ratio - w) < 1e-9
+                   and self.slenderness == lb for c, w, lb in HELD_OUT_SCENES)
+        return "held-out" if held else "fit"
 
     @property
     def actual_slenderness(self) -> float:
@@ -201,7 +206,7 @@ def reference_scenes() -> list[ReferenceScene]:
             out.append(ReferenceScene(c, w, None, study, _relative(study_file),
                                       _study_hash(study_file) if study_file.exists() else "", stored))
     gold_map = {}
-    for c, w, lb in MAP_SCENES:
+    for c, w, lb in MAP_SCENES + NEW_MAP_SCENES + HELD_OUT_SCENES:
         name = fem_scene_name(c, w, lb)
         study_file = FEM_GOLD / name / "richardson.json"
         study = load_study("fem", c, w, name=name) if study_file.exists() else None
@@ -274,7 +279,12 @@ def row_errors(reference: Study | None, summary: dict, rows: list[dict]) -> dict
         h = np.array([float(r["H_mid_over_L"]) for r in shear])
         order = np.argsort(dw)
         dw, h = dw[order], h[order]
-        keep = away_from(curve.dw, reference.thresholds(), THRESHOLD_BAND) & (curve.dw >= dw[0]) & (curve.dw <= dw[-1])
+        # away from both curves' thresholds: the reference's and the run's own (rules version 3). Near
+        # either, H_mid jumps (US -> S) or turns (U -> US), and a threshold error shows as an H_mid
+        # error of order the jump; the thresholds are measured by their own quantities
+        own = [summary.get(f"{k}_over_L") for k in ("dW1", "dW2")]
+        keep = (away_from(curve.dw, list(reference.thresholds()) + own, THRESHOLD_BAND) & (curve.dw >= dw[0])
+                & (curve.dw <= dw[-1]))
         if not np.any(keep):
             reasons.append("H_mid: no reference point inside the run's range away from the thresholds")
         else:
@@ -786,11 +796,11 @@ def figures(rows: list[dict], out: Path, tolerance: float = 0.01) -> list[str]:
 def missing_scenes(scenes: list[ReferenceScene]) -> list[str]:
     """What the map lacks, in words, from the scenes found."""
     out = []
-    for c, w, lb in MAP_SCENES:
+    for c, w, lb in MAP_SCENES + NEW_MAP_SCENES + HELD_OUT_SCENES:
         name = fem_scene_name(c, w, lb)
         study = load_study("fem", c, w, name=name) if (FEM_GOLD / name / "richardson.json").exists() else None
         if study is None or len(study.meshes) < 2:
-            role = "held-out" if not any(abs(w - x) < 1e-9 for x in WIDTHS_GOLD) else "fit"
+            role = "held-out" if (c, w, lb) in HELD_OUT_SCENES else "fit"
             done = 0 if study is None else len(study.meshes)
             out.append(f"{name} ({role}): {done} FEM mesh(es) finished, a reference needs two or more "
                        f"(python -m fem_reference gold --only {name})")

@@ -1,46 +1,62 @@
 """Which model is enough for a scene: the error map read back, a conservative prediction of each
 model's error on a scene, and the cheapest model and resolution predicted within a tolerance
-(issue 17 item 4: `python -m ddg advise`, `ddg.simulate(..., model="auto", tolerance=...)`).
+(issue 17 item 4, rule v3 of issue 32: `python -m ddg advise`, `ddg.simulate(..., model="auto",
+tolerance=...)`).
 
 The error map (data/error_map/error_map.csv, written by `python -m validation.error_map`) has one
 row per (model, resolution, scene): for each quantity q of dW1/L, dW2/L and H_mid/L its error
 against the converged FEM reference of that scene and the reference's own error bar, and their sum
 `q_bound` (for H_mid the largest pointwise sum over the shear path, 0.02 L away from the
-reference's thresholds), with the run's wall time. Rows of held-out scenes (column role =
-"held-out") are never used to predict: they exist to check the prediction.
+reference's and the run's own thresholds), with the run's wall time. A bound is the whole error of
+that run: the model's error and its mesh's, measured against the reference. Rows of held-out scenes
+(column role = "held-out") are never used to predict: they exist to check the prediction.
 
-Prediction rule (conservative, never an extrapolation). A scene is (dL/L, W/L, L/b). Its basis is
-the map scenes of the same dL/L that bracket it: in W/L the nearest map width at or below it and
-the nearest at or above it (one width where it equals a map width); at each of those widths, in
-L/b the nearest map L/b at or below and at or above (one where it equals one, to 0.1 %). A scene
-whose dL/L is not in the map, or whose W/L or L/b lies outside the map's range at a bracketing
-width, has no basis: it is outside the map. The predicted error of a candidate on quantity q is the
-largest q_bound over the basis scenes (error plus reference error bar: the worst of the bracketing
-scenes), times the map's cross-validated margin (below); a candidate missing at one basis scene, or whose
-q is missing there (e.g. dW2 null), has no prediction for q and is not chosen. Its predicted cost
-is its largest wall time over the basis scenes. The choice is the candidate of least predicted
-cost whose predicted errors on the requested quantities are all at most the tolerance.
+Prediction rule v3 (conservative, never an extrapolation; fixed and committed before the
+references of its held-out scenes, fem_reference.gold.HELD_OUT_SCENES, were computed).
+A scene is (dL/L, W/L, L/b), nu = 0 (the map's; another nu is refused, check_mapped_poisson_ratio).
+Its L/b is read relative to the paper's strip at the same dL/L (relative slenderness
+(L/b) / (L/b)_paper(dL/L): the thickness in units of the paper's, since the paper's L/b grows with
+dL/L: 787 at 1/4, 886 at 1/3, 1181 at 1/2). Its basis is the corners of the map's box about it:
+the map compressions bracketing dL/L (the one equal to it to 0.1 %, else the nearest below and above);
+at each, the map widths bracketing W/L; at each of those, the relative slendernesses bracketing the
+scene's. A scene for which one bracket fails is outside the map.
+Candidates, each predicted on each quantity on its own (a missing bound makes that quantity
+unknown for that candidate only):
+- the rod's family (rod, ribbons), keyed by node count M: at each basis scene the bound of that M;
+- the plates, keyed by element size h/L = (W/L) / rows: the sizes measured at the basis scenes,
+  each as the even number of rows across the scene's W nearest W/h; at each basis scene the larger
+  bound of the two measured meshes whose sizes bracket h (the one of that size where equal), and
+  none where h lies outside the sizes measured there (no extrapolation in h either).
+The predicted error on q is the largest of those basis bounds times the map's cross-validated
+margin (below); the predicted cost the largest wall time of the meshes used at the basis scenes.
+The choice is the cheapest candidate predicted within the tolerance on every quantity asked that
+the map knows at the scene; a quantity no candidate has a bound for there (e.g. H_mid where the
+reference's runs stopped short) is reported unknown, not counted against every model. When no
+candidate is within, the choice is the most accurate candidate (least largest predicted error on
+the quantities asked), labelled as not within the tolerance with its predicted error. Outside the
+map nothing is predicted: the choice is the candidate most accurate at the nearest map scene
+(distance in log dL/L, log W/L, log relative L/b), at its node count or element size, labelled
+with an unknown error.
 
-Cross-validated margin (rule v2). Errors are not monotone in W/L: the plate on 8 rows is worse at
-W/L = 1/8 than at 1/12 and at 1/6, so the largest bound of the bracketing scenes (rule v1, margin 1)
-can understate an interior scene's error. The margin is measured on the fitting scenes alone,
-leave-one-out: each fitting scene bracketed by the others is predicted from them by rule v1, and the
-margin is the largest ratio measured bound / predicted bound over every (candidate, quantity) there,
-and at least 1 (cross_validated_margin). It is recomputed from whatever map is read, never from the
-held-out scenes; it was introduced after rule v1 had been checked on the first three held-out scenes
-(data/error_map/README.md gives both rules' figures on every held-out scene). On a scene of the map
-itself (one basis scene: nothing interpolated) the bound measured there is the prediction, margin 1.
+Cross-validated margin (rule v2, kept). Errors are not monotone in the scene: the plate on 8 rows
+is worse at W/L = 1/8 than at 1/12 and at 1/6, so the largest bound of the bracketing scenes can
+understate an interior scene's error. The margin is measured on the fitting scenes alone,
+leave-one-out: each fitting scene bracketed by the others is predicted from them (margin 1, the
+plates at the rows measured there), and the margin is the largest ratio measured bound / predicted
+bound over every (candidate, quantity) there, and at least 1 (cross_validated_margin). It is
+recomputed from whatever map is read, never from the held-out scenes. On a scene of the map itself
+(one basis scene: nothing interpolated) the bound measured there is the prediction, margin 1.
 
-Safe choice: outside the map, or when no candidate is predicted within the tolerance, the paper's
-plate (Eq. 11) on a convergence pair, two exactly equilateral meshes refined by 1.5 (12 and 18
-rows of triangles across W for W/L <= 1/4, 24 and 36 above: the finer two meshes of the plate
-studies in data/plate_gold), whose difference measures the discretisation error of the finer one;
-the reason says which of the two cases it is. The FEM rows of the map are information only: the
-shell is not run by ddg.
+History: rule v1 (the largest bound of the bracketing scenes, one dL/L at a time) failed on its
+first held-out set; rule v2 added the margin and was checked on a second set; both fell back to a
+plate convergence pair whose mesh difference was reported as the error (issue 32: it understated the
+real error 8-18x on narrow strips). data/error_map/README.md gives every rule's held-out figures.
+The FEM rows of the map are information only: the shell is not run by ddg.
 """
 from __future__ import annotations
 
 import csv
+import functools
 import math
 import os
 from dataclasses import asdict, dataclass, field
@@ -62,11 +78,14 @@ TOLERANCE_RANGE = (0.0, 1.0)
 SAME = 1e-3
 #: Models the map holds that ddg does not run (information only).
 NOT_RUN = ("fem",)
-#: Plate of the safe choice: rows of triangles across W on the coarsest mesh of the plate studies
-#: (validation/plate_gold.py BASE_ROWS), by W/L; the pair is 1.5 and 2.25 times it.
-SAFE_MODEL = "plate"
-SAFE_BASE_ROWS = ((0.25, 8), (1.0, 16))
-REFINEMENT = 1.5
+#: The plates: keyed by element size, not node count.
+PLATE_MODELS = ("plate", "plate-midedge")
+#: The prediction rule of this module (docstring); summary.json's auto block names it.
+RULE = "v3"
+#: The Poisson ratio of every scene of the map (the FEM references and the runs are at nu = 0).
+MAP_POISSON_RATIO = 0.0
+#: Used only when the map has no runnable row at all: the mid-edge plate on 18 rows.
+FALLBACK_MODEL, FALLBACK_ROWS = "plate-midedge", 18
 
 
 # ------------------------------------------------------------------------------------ input checks
@@ -96,6 +115,17 @@ def check_quantities(value) -> tuple[str, ...]:
         if v not in QUANTITIES:
             raise InputError(f"quantity {v!r} is not in the error map; allowed {', '.join(QUANTITIES)}")
     return tuple(dict.fromkeys(items))
+
+
+def check_mapped_poisson_ratio(value) -> float:
+    """nu as a float if the map has it (MAP_POISSON_RATIO); InputError naming it otherwise: the
+    map's errors are measured at nu = 0, and nu moves the thresholds by as much as the tolerances
+    asked (issue 32: the rod's dW1/L by 0.0078 at nu = 0.25), so no error can be predicted."""
+    nu = float(value)
+    if abs(nu - MAP_POISSON_RATIO) > 1e-12:
+        raise InputError(f"poisson_ratio = {value!r}: the error map is measured at nu = {MAP_POISSON_RATIO:g} only "
+                         f"(nu moves dW1/L by 0.0078 at 0.25), so no model can be advised; choose a --model")
+    return nu
 
 
 def map_file(path=None) -> tuple[Path, bool]:
@@ -160,6 +190,12 @@ def parse_rows(raw_rows) -> list[dict]:
     return rows
 
 
+@functools.lru_cache(maxsize=None)
+def paper_slenderness(compression_ratio: float) -> float:
+    """L/b of the paper's strip (b = 0.127 mm) at this dL/L (its L grows with dL/L)."""
+    return Strip.from_ratios(0.05, compression_ratio, None).slenderness
+
+
 @dataclass(frozen=True)
 class Scene:
     """A scene of the map: dL/L, W/L, L/b."""
@@ -170,6 +206,11 @@ class Scene:
     @property
     def name(self) -> str:
         return scene_name(self.compression_ratio, self.width_ratio, self.slenderness)
+
+    @property
+    def relative_slenderness(self) -> float:
+        """(L/b) / (L/b)_paper at the same dL/L: the paper's thickness over this one's."""
+        return self.slenderness / paper_slenderness(self.compression_ratio)
 
 
 def scene_name(compression_ratio: float, width_ratio: float, slenderness: float) -> str:
@@ -205,26 +246,34 @@ def _bracket(values: list[float], x: float) -> list[float] | None:
 
 
 def basis_scenes(rows, scene: Scene) -> tuple[list[Scene], str]:
-    """The map scenes bracketing `scene` (module docstring), and "" ; or [] and why it is outside."""
-    scenes = [s for s in map_scenes(rows) if _same(s.compression_ratio, scene.compression_ratio)]
-    if not scenes:
-        have = sorted({f"{s.compression_ratio:g}" for s in map_scenes(rows)})
-        return [], (f"dL/L = {scene.compression_ratio:g} is not in the map (it has dL/L = {', '.join(have) or 'none'})")
-    widths = _bracket([s.width_ratio for s in scenes], scene.width_ratio)
-    if widths is None:
-        lo, hi = min(s.width_ratio for s in scenes), max(s.width_ratio for s in scenes)
-        return [], f"W/L = {scene.width_ratio:.4g} is outside the map's range [{lo:.4g}, {hi:.4g}] at dL/L = " \
-                   f"{scene.compression_ratio:g}"
+    """The map scenes at the corners of the box about `scene` (module docstring, rule v3), and "";
+    or [] and why it is outside."""
+    scenes = map_scenes(rows)
+    compressions = _bracket([s.compression_ratio for s in scenes], scene.compression_ratio)
+    if compressions is None:
+        have = ", ".join(f"{c:.4g}" for c in sorted({s.compression_ratio for s in scenes})) or "none"
+        return [], f"dL/L = {scene.compression_ratio:.4g} is outside the map's compressions ({have})"
     basis = []
-    for w in widths:
-        at = [s for s in scenes if _same(s.width_ratio, w)]
-        lbs = _bracket([s.slenderness for s in at], scene.slenderness)
-        if lbs is None:
-            have = ", ".join(f"{s.slenderness:.0f}" for s in sorted(at, key=lambda s: s.slenderness))
-            return [], (f"L/b = {scene.slenderness:.4g} is outside the map's L/b at W/L = {w:.4g}, dL/L = "
-                        f"{scene.compression_ratio:g} (it has L/b = {have})")
-        basis += [s for s in at if any(_same(s.slenderness, b) for b in lbs)]
+    for c in compressions:
+        at_c = [s for s in scenes if _same(s.compression_ratio, c)]
+        widths = _bracket([s.width_ratio for s in at_c], scene.width_ratio)
+        if widths is None:
+            lo, hi = min(s.width_ratio for s in at_c), max(s.width_ratio for s in at_c)
+            return [], f"W/L = {scene.width_ratio:.4g} is outside the map's range [{lo:.4g}, {hi:.4g}] at dL/L = {c:.4g}"
+        for w in widths:
+            at = [s for s in at_c if _same(s.width_ratio, w)]
+            relative = _bracket([s.relative_slenderness for s in at], scene.relative_slenderness)
+            if relative is None:
+                have = ", ".join(f"{s.slenderness:.0f}" for s in sorted(at, key=lambda s: s.slenderness))
+                return [], (f"L/b = {scene.slenderness:.4g} ({scene.relative_slenderness:.3g} times the paper's at "
+                            f"dL/L = {scene.compression_ratio:.4g}) is outside the map's L/b at W/L = {w:.4g}, "
+                            f"dL/L = {c:.4g} (it has L/b = {have}, read as {_relative_list(at)} times the paper's)")
+            basis += [s for s in at if any(_same(s.relative_slenderness, r) for r in relative)]
     return basis, ""
+
+
+def _relative_list(scenes) -> str:
+    return ", ".join(f"{s.relative_slenderness:.3g}" for s in sorted(scenes, key=lambda s: s.slenderness))
 
 
 # ------------------------------------------------------------------------------------ prediction
@@ -234,10 +283,25 @@ def at_scene(row, s: Scene) -> bool:
             and _same(float(row["width_ratio"]), s.width_ratio) and _same(float(row["slenderness"]), s.slenderness))
 
 
+def element_size(row) -> float | None:
+    """A plate row's element size h/L = (W/L) / rows (rows of triangles across W); None for the
+    rod's family (keyed by its node count M)."""
+    if row["model"] not in PLATE_MODELS or row.get("resolution") is None:
+        return None
+    return float(row["width_ratio"]) / float(row["resolution"])
+
+
+def even_rows(width_ratio: float, size: float) -> int:
+    """The even number of rows of triangles across W nearest W / h (at least 2): the plate mesh of
+    element size `size` (units of L) on a strip of W/L = `width_ratio`."""
+    return max(2, 2 * int(round(width_ratio / size / 2)))
+
+
 @dataclass
 class Prediction:
-    """A candidate (model, resolution) on a scene: predicted error per quantity (None: no
-    prediction, see why), predicted wall time (s), the basis scenes."""
+    """A candidate (model, resolution) on a scene: predicted error per quantity (None: unknown for
+    this candidate, see why), predicted wall time (s), the basis scenes, and for a plate its element
+    size h/L and the map meshes each basis scene's bound came from."""
     model: str
     resolution: int
     label: str
@@ -245,45 +309,77 @@ class Prediction:
     wall_time_s: float | None
     basis: list[str]
     why: dict = field(default_factory=dict)
+    element_size: float | None = None
+    meshes: dict = field(default_factory=dict)
 
     def within(self, tolerance: float, quantities) -> bool:
         return all(self.errors.get(q) is not None and self.errors[q] <= tolerance for q in quantities)
 
     def worst(self, quantities) -> float:
         values = [self.errors.get(q) for q in quantities]
-        return math.inf if any(v is None for v in values) else max(values)
+        return math.inf if not values or any(v is None for v in values) else max(values)
 
 
-def predictions(rows, basis: list[Scene], runnable=None, margin: float = 1.0) -> list[Prediction]:
-    """Each candidate of the map (not NOT_RUN; among `runnable` model names if given) predicted
-    on the basis scenes, by the rule of the module docstring: the largest bound of the basis
-    scenes times `margin` (1: rule v1)."""
-    candidates = {}
-    for r in rows:
-        if r["model"] in NOT_RUN or (runnable is not None and r["model"] not in runnable):
-            continue
-        if r.get("resolution") is None:
-            continue
-        candidates.setdefault((r["model"], int(r["resolution"]), r["resolution_label"]), []).append(r)
+def _predict(model, resolution, label, size, basis, used, margin) -> Prediction:
+    """One candidate from its map rows at each basis scene (`used`: a list of rows per scene, two
+    for a plate between two measured meshes): per quantity the largest bound, times `margin`."""
+    errors, why = {}, {}
+    for q in QUANTITIES:
+        values = []
+        for s, found in zip(basis, used):
+            if not found:
+                why[q] = f"no row at {s.name}"
+                break
+            missing = [r for r in found if r.get(f"{q}_bound") is None]
+            if missing:
+                r = missing[0]
+                why[q] = f"{q} missing at {s.name}, {r['resolution_label']}: {r.get('reason') or 'no value'}"
+                break
+            values += [r[f"{q}_bound"] for r in found]
+        errors[q] = max(values) * margin if q not in why else None
+    times = [max(r["wall_time_s"] for r in found) for found in used
+             if found and all(r.get("wall_time_s") is not None for r in found)]
+    wall = max(times) if len(times) == len(basis) else None
+    meshes = {s.name: [r["resolution_label"] for r in found] for s, found in zip(basis, used)}
+    return Prediction(model, resolution, label, errors, wall, [s.name for s in basis], why, size, meshes)
+
+
+def _meshes_about(found: list[dict], size: float) -> list[dict] | None:
+    """The plate rows of one scene whose element sizes bracket `size`: the one of that size, else
+    the nearest coarser and the nearest finer; None outside the measured sizes (no extrapolation)."""
+    sizes = _bracket([element_size(r) for r in found], size)
+    if sizes is None:
+        return None
+    return [next(r for r in found if _same(element_size(r), h)) for h in sizes]
+
+
+def predictions(rows, basis: list[Scene], scene: Scene | None = None, runnable=None, margin: float = 1.0,
+                plate_rows=()) -> list[Prediction]:
+    """Each candidate of the map (not NOT_RUN; among `runnable` model names if given) predicted on
+    `scene` from the `basis` scenes by rule v3 (module docstring): the rod's family keyed by node
+    count, the plates by element size (the sizes measured at the basis scenes, as even rows across
+    the scene's W, and `plate_rows` besides). Cheapest first."""
+    scene = scene if scene is not None else basis[0]
+    usable = [r for r in rows if r["model"] not in NOT_RUN and (runnable is None or r["model"] in runnable)
+              and r.get("resolution") is not None]
+    per_basis = [[r for r in usable if at_scene(r, s)] for s in basis]
     out = []
-    for (model, resolution, label), mine in candidates.items():
-        errors, why, times = {}, {}, []
-        per_scene = [[r for r in mine if at_scene(r, s)] for s in basis]
-        for q in QUANTITIES:
-            values = []
-            for s, found in zip(basis, per_scene):
-                bound = found[-1].get(f"{q}_bound") if found else None
-                if bound is None:
-                    why[q] = (f"no row at {s.name}" if not found
-                              else f"{q} missing at {s.name}: {found[-1].get('reason') or 'no value'}")
-                    break
-                values.append(bound)
-            errors[q] = max(values) * margin if q not in why else None
-        for found in per_scene:
-            if found and found[-1].get("wall_time_s") is not None:
-                times.append(found[-1]["wall_time_s"])
-        wall = max(times) if len(times) == len(basis) else None
-        out.append(Prediction(model, resolution, label, errors, wall, [s.name for s in basis], why))
+    keys = dict.fromkeys((r["model"], int(r["resolution"]), r["resolution_label"]) for r in usable
+                         if r["model"] not in PLATE_MODELS)
+    for model, resolution, label in keys:
+        used = [[r for r in found if r["model"] == model and r["resolution_label"] == label][-1:]
+                for found in per_basis]
+        out.append(_predict(model, resolution, label, None, basis, used, margin))
+    for model in dict.fromkeys(r["model"] for r in usable if r["model"] in PLATE_MODELS):
+        meshes = [[r for r in found if r["model"] == model] for found in per_basis]
+        sizes = {element_size(r) for found in meshes for r in found}
+        options = sorted({even_rows(scene.width_ratio, h) for h in sizes} | {int(n) for n in plate_rows})
+        for n in options:
+            size = scene.width_ratio / n
+            used = [_meshes_about(found, size) for found in meshes]
+            if any(u is None for u in used):
+                continue          # outside the measured element sizes at a basis scene
+            out.append(_predict(model, n, f"R{n}", size, basis, used, margin))
     out.sort(key=lambda p: (math.inf if p.wall_time_s is None else p.wall_time_s, p.model, p.resolution))
     return out
 
@@ -310,20 +406,22 @@ class Margin:
 
 #: Rule v1: the largest bound of the bracketing scenes as it is (no margin).
 RULE_V1_MARGIN = Margin(1.0, 0, 0, "rule v1: no margin")
-#: A scene of the map itself (its W/L and L/b both in the map): the bound measured there, no margin
-#: (nothing is interpolated).
+#: A scene of the map itself (its dL/L, W/L and L/b all in the map): the bound measured there, no
+#: margin (nothing is interpolated).
 ON_A_MAP_SCENE = Margin(1.0, 0, 0, "on a map scene: measured there")
 
 
 def compared_at(rows, scene: Scene, basis: list[Scene], runnable=None, margin: float = 1.0,
                 quantities=QUANTITIES) -> list[tuple[Prediction, str, float, float]]:
     """Leave one out: `scene`'s own rows are set aside, the other `rows` predict each candidate on
-    `basis` (times `margin`), and each prediction meets the candidate's measured bound at `scene`:
-    (prediction, quantity, predicted, measured) wherever both exist."""
+    `scene` from `basis` (times `margin`; the plates also at the rows measured at `scene`), and each
+    prediction meets the candidate's measured bound at `scene`: (prediction, quantity, predicted,
+    measured) wherever both exist."""
     mine = {(r["model"], r["resolution_label"]): r for r in rows if at_scene(r, scene)}
     others = [r for r in rows if not at_scene(r, scene)]
+    plate_rows = {int(r["resolution"]) for r in mine.values() if r["model"] in PLATE_MODELS}
     out = []
-    for p in predictions(others, basis, runnable, margin):
+    for p in predictions(others, basis, scene, runnable, margin, plate_rows):
         row = mine.get((p.model, p.label))
         if row is None:
             continue
@@ -357,9 +455,11 @@ def cross_validated_margin(rows, runnable=None) -> Margin:
 
 @dataclass
 class Choice:
-    """What `advise` recommends for a scene (auto_block() is what summary.json stores)."""
+    """What `advise` recommends for a scene (auto_block() is what summary.json stores). `within`:
+    predicted within the tolerance on every quantity asked that the map knows at the scene;
+    `unknown`: the quantities asked that no candidate has a bound for there (with why)."""
     model: str
-    resolution: int | list
+    resolution: int
     label: str
     reason: str
     predicted_errors: dict
@@ -369,42 +469,60 @@ class Choice:
     quantities: tuple
     scene: Scene
     inside_map: bool
-    safe: bool
+    within: bool
     wall_time_s: float | None = None
     cost_basis: str = ""
     candidates: list = field(default_factory=list, repr=False)
     margin: Margin | None = None
+    unknown: dict = field(default_factory=dict)
+    element_size: float | None = None
+
+    @property
+    def safe(self) -> bool:
+        """Not predicted within the tolerance (outside the map, or no candidate within): the
+        summary's `safe_choice` key, kept for readers of earlier summaries."""
+        return not self.within
+
+    def verdict(self) -> str:
+        if self.within:
+            return f"predicted within {self.tolerance:g}"
+        if not self.inside_map:
+            return "OUTSIDE THE MAP: error unknown"
+        return f"NOT WITHIN THE TOLERANCE {self.tolerance:g}: the most accurate candidate, predicted {_fmt(self.worst())}"
+
+    def worst(self) -> float | None:
+        values = [self.predicted_errors.get(q) for q in self.quantities if q not in self.unknown]
+        return None if not values or any(v is None for v in values) else max(values)
 
     def auto_block(self) -> dict:
         return {"chosen_model": self.model, "resolution": self.resolution, "resolution_label": self.label,
                 "reason": self.reason, "predicted_errors": dict(self.predicted_errors),
                 "basis_scenes": list(self.basis_scenes), "map_file": self.map_file, "tolerance": self.tolerance,
                 "quantities": list(self.quantities), "inside_map": self.inside_map, "safe_choice": self.safe,
+                "within_tolerance": self.within, "verdict": self.verdict(), "rule": RULE,
+                "unknown_quantities": dict(self.unknown), "element_size_over_L": self.element_size,
                 "predicted_wall_time_s": self.wall_time_s, "cost_basis": self.cost_basis,
                 "margin": None if self.margin is None else self.margin.value,
                 "margin_basis": None if self.margin is None else self.margin.text(),
                 "scene": asdict(self.scene) | {"name": self.scene.name}}
 
 
-def safe_rows(width_ratio: float) -> tuple[int, int]:
-    """The plate's convergence pair (rows of triangles across W) of the safe choice."""
-    base = next(rows for limit, rows in SAFE_BASE_ROWS if width_ratio <= limit)
-    return int(round(base * REFINEMENT)), int(round(base * REFINEMENT**2))
-
-
 def _fmt(value) -> str:
-    return "none" if value is None else f"{value:.4f}"
+    return "unknown" if value is None else f"{value:.4f}"
 
 
 def choose(width_ratio, compression_ratio, slenderness=None, tolerance=None, quantities=None, rows=None,
-           path=None, runnable=None, margin: Margin | None = None) -> Choice:
+           path=None, runnable=None, margin: Margin | None = None, poisson_ratio=0.0) -> Choice:
     """The cheapest candidate predicted within `tolerance` on `quantities` at the scene (W/L,
     dL/L, L/b; L/b None: the paper's thickness), from the map `rows` (default: read from `path`,
-    $DDG_ERROR_MAP or DEFAULT_MAP), else the safe choice with the reason. `margin` None: the map's
-    cross-validated margin (RULE_V1_MARGIN: rule v1). Inputs are checked first (InputError)."""
+    $DDG_ERROR_MAP or DEFAULT_MAP); else the most accurate candidate, labelled as not within the
+    tolerance, with its predicted error; outside the map the model most accurate over the map,
+    labelled with an unknown error (module docstring). `margin` None: the map's cross-validated
+    margin (RULE_V1_MARGIN: rule v1). Inputs are checked first (InputError), nu among them."""
     tolerance = check_tolerance(tolerance)
     quantities = check_quantities(quantities)
-    strip = Strip.from_ratios(width_ratio, compression_ratio, slenderness)
+    strip = Strip.from_ratios(width_ratio, compression_ratio, slenderness, poisson_ratio=poisson_ratio)
+    check_mapped_poisson_ratio(strip.poisson_ratio)
     scene = Scene(float(compression_ratio), float(width_ratio), float(strip.slenderness))
     if rows is None:
         file, _ = map_file(path)
@@ -413,50 +531,91 @@ def choose(width_ratio, compression_ratio, slenderness=None, tolerance=None, qua
     else:
         where = str(path) if path is not None else "(rows given)"
     rows = fitting(rows)
-    names = "/".join(quantities)
     basis, outside = basis_scenes(rows, scene) if rows else ([], f"the error map {where} has no rows")
     if not basis:
-        return _safe(scene, tolerance, quantities, where, rows, inside=False,
-                     reason=f"outside the error map: {outside}; nothing is extrapolated, so the safe choice")
+        return _outside(scene, tolerance, quantities, where, rows, runnable, outside)
     if margin is None:
         margin = ON_A_MAP_SCENE if len(basis) == 1 else cross_validated_margin(rows, runnable)
-    found = predictions(rows, basis, runnable, margin.value)
-    eligible = [p for p in found if p.within(tolerance, quantities) and p.wall_time_s is not None]
+    found = predictions(rows, basis, scene, runnable, margin.value)
+    unknown = {q: next(iter(p.why[q] for p in found if q in p.why), "no candidate") for q in quantities
+               if all(p.errors.get(q) is None for p in found)}
+    judged = tuple(q for q in quantities if q not in unknown)
+    names = "/".join(judged)
+    unknown_text = "".join(f"; {q}: no candidate's error is known here ({why})" for q, why in unknown.items())
+    basis_text = (f"the largest bound over the bracketing map scenes {', '.join(s.name for s in basis)}, times the "
+                  f"{margin.text()}")
+    eligible = [p for p in found if judged and p.within(tolerance, judged) and p.wall_time_s is not None]
     if eligible:
         p = eligible[0]
-        errors = ", ".join(f"{q} {_fmt(p.errors[q])}" for q in quantities)
+        errors = ", ".join(f"{q} {_fmt(p.errors[q])}" for q in judged)
         reason = (f"the cheapest of {len(eligible)} candidates predicted within {tolerance:g} on {names} "
-                  f"(predicted error + reference error bar: {errors}; the largest over the bracketing map scenes "
-                  f"{', '.join(p.basis)}, times the {margin.text()})")
-        return Choice(p.model, p.resolution, p.label, reason, {q: p.errors[q] for q in QUANTITIES},
-                      [s.name for s in basis], where, tolerance, quantities, scene, True, False, p.wall_time_s,
-                      f"largest wall time of {p.model} {p.label} on the basis scenes", found, margin)
-    best = min(found, key=lambda p: p.worst(quantities), default=None)
-    best_text = (f"; the closest is {best.model} {best.label} at {_fmt(best.worst(quantities))}"
-                 if best is not None and math.isfinite(best.worst(quantities)) else "")
-    return _safe(scene, tolerance, quantities, where, rows, inside=True, basis=basis, candidates=found, margin=margin,
-                 reason=(f"no candidate of the map is predicted within {tolerance:g} on {names} at the bracketing "
-                         f"scenes {', '.join(s.name for s in basis)} (their largest bound times the "
-                         f"{margin.text()}){best_text}: the safe choice"))
+                  f"(predicted error + reference error bar: {errors}; {basis_text}){unknown_text}")
+        return _choice(p, reason, scene, basis, where, tolerance, quantities, True, True, found, margin, unknown)
+    ranked = [p for p in found if judged and math.isfinite(p.worst(judged))]
+    if not ranked:
+        return _outside(scene, tolerance, quantities, where, rows, runnable,
+                        f"no candidate has a bound on {'/'.join(quantities)} at the bracketing scenes "
+                        f"{', '.join(s.name for s in basis)}{unknown_text}", basis=basis, candidates=found,
+                        margin=margin, unknown=unknown)
+    best = min(ranked, key=lambda p: (p.worst(judged), math.inf if p.wall_time_s is None else p.wall_time_s))
+    errors = ", ".join(f"{q} {_fmt(best.errors[q])}" for q in judged)
+    reason = (f"no candidate is predicted within {tolerance:g} on {names}: the most accurate, NOT within the "
+              f"tolerance (predicted error + reference error bar: {errors}; {basis_text}){unknown_text}")
+    return _choice(best, reason, scene, basis, where, tolerance, quantities, True, False, found, margin, unknown)
 
 
-def _safe(scene, tolerance, quantities, where, rows, inside, reason, basis=(), candidates=(), margin=None) -> Choice:
-    pair = list(safe_rows(scene.width_ratio))
-    label = f"R{pair[0]}+R{pair[1]}"
-    # cost: the plate's finer mesh on the map's scenes of the same dL/L (not this scene's), if any
-    times = [r["wall_time_s"] for r in rows if r["model"] == SAFE_MODEL and r.get("resolution") == pair[1]
-             and r.get("wall_time_s") is not None and _same(float(r["compression_ratio"]), scene.compression_ratio)]
-    coarse = [r["wall_time_s"] for r in rows if r["model"] == SAFE_MODEL and r.get("resolution") == pair[0]
-              and r.get("wall_time_s") is not None and _same(float(r["compression_ratio"]), scene.compression_ratio)]
-    wall = max(times) + max(coarse) if times and coarse else None
-    cost = (f"largest wall times of the plate R{pair[0]} and R{pair[1]} on the map's scenes at dL/L = "
-            f"{scene.compression_ratio:g} (not this scene), summed" if wall is not None
-            else f"the map has no plate run on R{pair[0]} and R{pair[1]} at dL/L = {scene.compression_ratio:g}")
-    errors = {q: None for q in QUANTITIES}
-    return Choice(SAFE_MODEL, pair, label, reason + f" (the plate on the convergence pair {pair[0]}/{pair[1]} rows; "
-                  "the difference of the two measures the finer one's discretisation error)", errors,
-                  [s.name for s in basis], where, tolerance, quantities, scene, inside, True, wall, cost,
-                  list(candidates), margin)
+def _choice(p: Prediction, reason, scene, basis, where, tolerance, quantities, inside, within, found, margin,
+            unknown) -> Choice:
+    cost = (f"largest wall time of {p.model} {' / '.join(dict.fromkeys(x for v in p.meshes.values() for x in v))} "
+            f"on the basis scenes")
+    return Choice(p.model, p.resolution, p.label, reason, {q: p.errors.get(q) for q in QUANTITIES},
+                  [s.name for s in basis], where, tolerance, quantities, scene, inside, within, p.wall_time_s, cost,
+                  found, margin, unknown, p.element_size)
+
+
+def _distance(a: Scene, b: Scene) -> float:
+    return math.hypot(math.log(a.compression_ratio / b.compression_ratio), math.log(a.width_ratio / b.width_ratio),
+                      math.log(a.relative_slenderness / b.relative_slenderness))
+
+
+def _worst_bound(row, quantities) -> float:
+    values = [row.get(f"{q}_bound") for q in quantities]
+    return math.inf if not values or None in values else max(values)
+
+
+def _outside(scene, tolerance, quantities, where, rows, runnable, why, basis=(), candidates=(), margin=None,
+             unknown=None) -> Choice:
+    """Outside the map (or nothing known at the basis): no error is predicted. The choice is the
+    candidate most accurate at the nearest map scene (distance in log dL/L, log W/L and log relative
+    L/b): the least largest bound on `quantities` there, at its node count (the rod's family) or its
+    element size on this scene's width (the plates)."""
+    usable = [r for r in rows if r["model"] not in NOT_RUN and (runnable is None or r["model"] in runnable)
+              and r.get("resolution") is not None]
+    nearest = min(map_scenes(usable), key=lambda s: _distance(s, scene), default=None)
+    if nearest is None:
+        model, resolution, wall, size = FALLBACK_MODEL, FALLBACK_ROWS, None, scene.width_ratio / FALLBACK_ROWS
+        label, cost = f"R{resolution}", "unknown (the map has no run of a model ddg runs)"
+        measured = f"the map has no run of a model ddg runs, so the mid-edge plate on {FALLBACK_ROWS} rows"
+    else:
+        here = [r for r in usable if at_scene(r, nearest)]
+        best = min(here, key=lambda r: (_worst_bound(r, quantities), r.get("wall_time_s") or math.inf))
+        model, resolution, size = best["model"], int(best["resolution"]), None
+        if model in PLATE_MODELS:   # the same element size on this scene's width
+            size = element_size(best)
+            resolution = even_rows(scene.width_ratio, size)
+            size = scene.width_ratio / resolution
+        label = f"R{resolution}" if model in PLATE_MODELS else f"M{resolution}"
+        wall = best.get("wall_time_s")
+        cost = f"wall time of {model} {best['resolution_label']} at the nearest map scene {nearest.name}"
+        bound = _worst_bound(best, quantities)
+        measured = (f"the candidate most accurate at the nearest map scene {nearest.name} ({model} "
+                    f"{best['resolution_label']}, largest bound on {'/'.join(quantities)} there "
+                    f"{'unknown' if not math.isfinite(bound) else f'{bound:.4f}'}), at its "
+                    f"{'element size' if model in PLATE_MODELS else 'node count'}")
+    reason = f"outside the error map: {why}; nothing is extrapolated, so no error is predicted: {measured}"
+    return Choice(model, resolution, label, reason, {q: None for q in QUANTITIES}, [s.name for s in basis], where,
+                  tolerance, quantities, scene, False, False, wall, cost, list(candidates), margin,
+                  dict(unknown or {}), size)
 
 
 def study_mesh(model: str, strip: Strip, rows: int):
@@ -472,30 +631,36 @@ def study_mesh(model: str, strip: Strip, rows: int):
 
 # ------------------------------------------------------------------------------------ printing
 def format_choice(choice: Choice) -> str:
-    """The choice in words: model, resolution, predicted errors with their basis, cost."""
+    """The choice in words: model, resolution, verdict, predicted errors with their basis, cost,
+    and the table of candidates."""
     s = choice.scene
     lines = [f"scene: W/L = {s.width_ratio:.4g}, dL/L = {s.compression_ratio:g}, L/b = {s.slenderness:.4g} "
              f"(W^2/(bL) = {s.width_ratio**2 * s.slenderness:.3g}); tolerance {choice.tolerance:g} on "
-             f"{', '.join(choice.quantities)}; map {choice.map_file}"]
-    if choice.safe:
-        lines.append(f"choice: SAFE CHOICE, {choice.model} on two meshes, rows {choice.resolution[0]} and "
-                     f"{choice.resolution[1]}")
-    else:
-        lines.append(f"choice: {choice.model} {choice.label} (resolution {choice.resolution})")
+             f"{', '.join(choice.quantities)}; map {choice.map_file} (rule {RULE})"]
+    size = "" if choice.element_size is None else f", element size h/L = {choice.element_size:.5f}"
+    lines.append(f"choice: {choice.model} {choice.label} (resolution {choice.resolution}{size}): {choice.verdict()}")
     lines.append(f"reason: {choice.reason}")
-    if not choice.safe:
-        for q in QUANTITIES:
-            mark = "" if q in choice.quantities else " (not asked)"
-            lines.append(f"  predicted |{q} error| + reference error bar <= {_fmt(choice.predicted_errors[q])}{mark}")
+    for q in QUANTITIES:
+        mark = "" if q in choice.quantities else " (not asked)"
+        if q in choice.unknown:
+            mark += " (no candidate's error is known here)"
+        lines.append(f"  predicted |{q} error| + reference error bar: {_fmt(choice.predicted_errors[q])}{mark}")
+    if choice.basis_scenes:
         lines.append(f"  basis: {', '.join(choice.basis_scenes)}")
     if choice.margin is not None:
         lines.append(f"  {choice.margin.text()}")
     cost = "unknown" if choice.wall_time_s is None else f"about {choice.wall_time_s:.3g} s"
     lines.append(f"cost: {cost} ({choice.cost_basis})")
     if choice.candidates:
-        lines.append("candidates (predicted on the basis scenes, cheapest first):")
+        lines.append("candidates (predicted on this scene from the basis scenes, cheapest first; "
+                     "'-': unknown for that candidate):")
+        lines.append(f"  {'model':20s} {'mesh':6s} {'wall':>9s}  " + "  ".join(f"{q:>7s}" for q in QUANTITIES)
+                     + "  within")
         for p in choice.candidates:
-            errs = ", ".join(f"{q} {_fmt(p.errors.get(q))}" for q in QUANTITIES)
             wall = "?" if p.wall_time_s is None else f"{p.wall_time_s:.3g} s"
-            lines.append(f"  {p.model:16s} {p.label:8s} {wall:>9s}  {errs}")
+            errs = "  ".join("      -" if p.errors.get(q) is None else f"{p.errors[q]:7.4f}" for q in QUANTITIES)
+            judged = [q for q in choice.quantities if q not in choice.unknown]
+            ok = "yes" if judged and p.within(choice.tolerance, judged) else "no"
+            mark = " <- chosen" if (p.model, p.label) == (choice.model, choice.label) else ""
+            lines.append(f"  {p.model:20s} {p.label:6s} {wall:>9s}  {errs}  {ok}{mark}")
     return "\n".join(lines)

@@ -473,12 +473,12 @@ def simulate_auto(strip: Strip, protocol: LoadingProtocol, tolerance, quantities
                   resolution=None, out=None, options=None, progress=False, solver="static", dynamic_options=None,
                   mesh=None, frames=False, thresholds=True, branches=None, probe=None,
                   centerline=True) -> SimulationResult:
-    """ddg.simulate(..., model="auto"): ddg.advise.choose on this scene, then run_candidate with
-    the choice. The safe choice (outside the map, or nothing predicted within the tolerance) runs
-    the plate on both meshes of its convergence pair, the coarser into out/auto_pair/R<rows>, and
-    returns the finer. summary["auto"]: chosen_model, resolution, reason, predicted_errors,
-    basis_scenes, map_file (ddg.advise.Choice.auto_block), and for the safe choice `pair`: both
-    meshes' thresholds and their differences. Inputs are checked before any work."""
+    """ddg.simulate(..., model="auto"): ddg.advise.choose on this scene (rule v3), then run_candidate
+    with the choice: the cheapest candidate predicted within the tolerance, else the most accurate
+    one labelled as not within it, or outside the map the model the map measured most accurate,
+    labelled with an unknown error. summary["auto"]: chosen_model, resolution, verdict,
+    within_tolerance, reason, predicted_errors, basis_scenes, map_file (ddg.advise.Choice
+    .auto_block). Inputs are checked before any work; nu other than the map's is refused."""
     from .advise import choose
     from .output.io import check_output_directory, write_summary_json
 
@@ -498,26 +498,14 @@ def simulate_auto(strip: Strip, protocol: LoadingProtocol, tolerance, quantities
         raise InputError(f"probe = {probe!r} must be a ddg.solve.probe.Probe")
     protocol.resolved_shear_ratio(strip)
     choice = choose(strip.width_ratio, protocol.compression_ratio, strip.slenderness, tolerance, quantities,
-                    path=error_map, runnable=set(DEFAULT_RESOLUTION))
+                    path=error_map, runnable=set(DEFAULT_RESOLUTION), poisson_ratio=strip.poisson_ratio)
     if out is not None:
         check_output_directory(out)
     branches = bool(branches) if branches is not None else False
     common = dict(options=options, progress=progress, thresholds=thresholds, branches=branches, probe=probe,
                   centerline=centerline)
     block = choice.auto_block()
-    if choice.safe:
-        coarse_rows, fine_rows = choice.resolution
-        coarse_out = None if out is None else Path(out) / "auto_pair" / f"R{coarse_rows}"
-        coarse = run_candidate(strip, protocol, choice.model, coarse_rows, out=coarse_out, **common)
-        result = run_candidate(strip, protocol, choice.model, fine_rows, out=out, **common)
-        pair = {"rows": [coarse_rows, fine_rows], "coarse_folder": None if coarse_out is None else str(coarse_out)}
-        for key in ("dW1_over_L", "dW2_over_L", "H_mid_over_L_compressed"):
-            a, b = coarse.summary.get(key), result.summary.get(key)
-            pair[key] = [a, b]
-            pair[f"{key}_difference"] = None if a is None or b is None else abs(b - a)
-        block["pair"] = pair
-    else:
-        result = run_candidate(strip, protocol, choice.model, choice.resolution, out=out, **common)
+    result = run_candidate(strip, protocol, choice.model, choice.resolution, out=out, **common)
     result.summary["auto"] = block
     if out is not None:
         write_summary_json(Path(out) / "summary.json", result.summary)

@@ -110,6 +110,8 @@ def build_parser() -> argparse.ArgumentParser:
     adv.add_argument("--width-ratio", type=float, required=True, help="W/L")
     adv.add_argument("--compression-ratio", type=float, required=True, help="dL/L")
     adv.add_argument("--slenderness", type=float, default=None, help="L/b (default: b = 0.127 mm)")
+    adv.add_argument("--poisson-ratio", type=float, default=0.0,
+                     help="nu (default 0, the error map's; another value is refused: the map is at nu = 0)")
     _add_auto_arguments(adv, "")
     sub.add_parser("warmup", help="compile and cache the numba kernels once (scripts/setup.sh runs it), "
                                   "so the first run pays no JIT cost")
@@ -184,7 +186,6 @@ def written_files(out: Path) -> list[str]:
             found.append(f"{path}/ ({len(list(path.glob('*.vtu')))} frames, frames.pvd)")
         elif path.is_file():
             found.append(str(path))
-    found += [str(p) for p in sorted((out / "auto_pair").glob("R*")) if p.is_dir()]
     return found
 
 
@@ -403,7 +404,8 @@ def _finish_simulate(args, result, auto: bool = False) -> int:
         print(f"wrote {', '.join(written_files(Path(args.out)))}")
     if auto:
         block = s.get("auto") or {}
-        sys.stderr.write(f"auto: {block.get('chosen_model')} {block.get('resolution_label')}: {block.get('reason')}\n")
+        sys.stderr.write(f"auto: {block.get('chosen_model')} {block.get('resolution_label')}, {block.get('verdict')}: "
+                         f"{block.get('reason')}\n")
     for warning in s.get("warnings") or ():
         sys.stderr.write(f"warning: {warning}\n")
     if not result.converged:
@@ -434,7 +436,7 @@ def cmd_advise(args) -> int:
     quantities = check_quantities(args.quantities)
     map_file(args.error_map)
     choice = choose(args.width_ratio, args.compression_ratio, args.slenderness, tolerance, quantities,
-                    path=args.error_map, runnable=set(DEFAULT_RESOLUTION))
+                    path=args.error_map, runnable=set(DEFAULT_RESOLUTION), poisson_ratio=args.poisson_ratio)
     print(format_choice(choice))
     return 0
 
@@ -442,7 +444,7 @@ def cmd_advise(args) -> int:
 def cmd_simulate_auto(args, strip: Strip, protocol: LoadingProtocol) -> int:
     """`simulate --model auto --tolerance T`: the choice of ddg.advise run by ddg.simulate; every
     option is checked before any work (exit 2)."""
-    from .advise import check_quantities, check_tolerance, map_file
+    from .advise import check_mapped_poisson_ratio, check_quantities, check_tolerance, map_file
     from .api import simulate
     from .solve.continuation import ContinuationOptions
     from .solve.newton import NewtonOptions
@@ -456,6 +458,7 @@ def cmd_simulate_auto(args, strip: Strip, protocol: LoadingProtocol) -> int:
     tolerance = check_tolerance(args.tolerance)
     quantities = check_quantities(args.quantities)
     map_file(args.error_map)
+    check_mapped_poisson_ratio(strip.poisson_ratio)
     for flag, value in (("--resolution", args.resolution), ("--mesh", args.mesh), ("--zeta", args.zeta),
                         ("--ribbon-init", args.ribbon_init), ("--clamp-speed", args.clamp_speed)):
         if value is not None:

@@ -101,34 +101,58 @@ def _map_row(w, lb, model, label, wall, bound):
 
 
 def test_held_out_check_leaves_each_scene_out():
+    """W/L = 1/12 left out and predicted from 1/20 and 1/6: the rod on 100 nodes (predicted 0.02,
+    measured 0.006) holds, the rod on 50 (predicted 0.008, measured 0.03 on dW2) fails on that
+    quantity; at 0.01 the choice is the cheap M50, predicted within and measured not."""
     lb = 1181.1023622047244
     rows = [_map_row(w, lb, "rod", "M100", 1.0, b) for w, b in ((0.05, 0.004), (1 / 12, 0.006), (1 / 6, 0.02))]
-    rows += [_map_row(w, lb, "plate", "R12", 100.0, b) for w, b in ((0.05, 0.003), (1 / 12, 0.012), (1 / 6, 0.008))]
+    rows += [_map_row(w, lb, "rod", "M50", 0.5, b) for w, b in ((0.05, 0.003), (1 / 12, 0.006), (1 / 6, 0.008))]
+    rows[4]["dW2_bound"] = "0.03"
     out = {e["scene"]: e for e in em.held_out_check(rows, 0.01)}
     edge, middle = out["dL0.5_W0.05_Lb1181"], out["dL0.5_W0.08333_Lb1181"]
     assert not edge["held_out"] and "outside" in edge["why"]
     assert middle["held_out"] and middle["basis"] == ["dL0.5_W0.05_Lb1181", "dL0.5_W0.1667_Lb1181"]
-    # rod predicted 0.02 (measured 0.006: holds), plate predicted 0.008 (measured 0.012: fails), 3 quantities each
-    assert (middle["compared"], middle["held"]) == (6, 3) and len(middle["violations"]) == 3
-    assert middle["choice"] == "plate R12" and middle["choice_holds"] is False
-    assert middle["choice_measured"] == pytest.approx(0.012)
+    assert (middle["compared"], middle["held"]) == (6, 5) and middle["violations"] == [
+        "rod M50 dW2: measured 0.0300 > predicted 0.0080"]
+    assert middle["choice"] == "rod M50" and middle["choice_within"] and middle["choice_holds"] is False
+    assert middle["choice_measured"] == pytest.approx(0.03) and middle["choice_measured_wall"] == pytest.approx(0.5)
 
 
-def test_rule_v2_carries_the_margin_measured_on_the_fitting_scenes():
-    """A held-out W/L = 1/8 measured at 0.016: rule v1 predicts the worse of 1/12 and 1/6 (0.012) and
-    fails; rule v2 multiplies by the leave-one-out margin of the fitting scenes (1/12 measured 0.012
+def test_the_margin_measured_on_the_fitting_scenes_is_carried_to_the_held_out_ones():
+    """A held-out W/L = 1/8 measured at 0.016: margin 1 predicts the worse of 1/12 and 1/6 (0.012) and
+    fails; rule v3 multiplies by the leave-one-out margin of the fitting scenes (1/12 measured 0.012
     against 0.008 predicted from 1/20 and 1/6: 1.5) and holds. For the fitting scene 1/12 itself
     the margin is measured without it (nested): no other scene is bracketed, margin 1."""
     lb = 1181.1023622047244
-    rows = [_map_row(w, lb, "plate", "R12", 100.0, b) for w, b in ((0.05, 0.003), (1 / 12, 0.012), (1 / 6, 0.008))]
-    held = _map_row(0.125, lb, "plate", "R12", 100.0, 0.016)
+    rows = [_map_row(w, lb, "rod", "M100", 100.0, b) for w, b in ((0.05, 0.003), (1 / 12, 0.012), (1 / 6, 0.008))]
+    held = _map_row(0.125, lb, "rod", "M100", 100.0, 0.016)
     held["role"] = "held-out"
     v1 = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05, rule="v1")}
-    v2 = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05)}
-    e1, e2 = v1["dL0.5_W0.125_Lb1181"], v2["dL0.5_W0.125_Lb1181"]
+    v3 = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05)}
+    e1, e3 = v1["dL0.5_W0.125_Lb1181"], v3["dL0.5_W0.125_Lb1181"]
     assert (e1["compared"], e1["held"], e1["margin"]) == (3, 0, 1.0)
-    assert (e2["compared"], e2["held"]) == (3, 3) and e2["margin"] == pytest.approx(1.5)
-    assert v2["dL0.5_W0.08333_Lb1181"]["margin"] == 1.0 and v2["dL0.5_W0.08333_Lb1181"]["held"] == 0
+    assert (e3["compared"], e3["held"]) == (3, 3) and e3["margin"] == pytest.approx(1.5)
+    assert v3["dL0.5_W0.08333_Lb1181"]["margin"] == 1.0 and v3["dL0.5_W0.08333_Lb1181"]["held"] == 0
+
+
+def test_held_out_targets_count_scenes_choices_and_predictions():
+    """Issue 32's targets from the check's entries: scenes inside the map, choices predicted within,
+    the median wall time of those (measured where the scene has the chosen run), predictions holding."""
+    entries = [
+        {"role": "held-out", "held_out": True, "choice_within": True, "choice_measured_wall": 4.0,
+         "choice_predicted_wall": 9.0, "held": 9, "compared": 10, "choice_holds": True},
+        {"role": "held-out", "held_out": True, "choice_within": True, "choice_measured_wall": None,
+         "choice_predicted_wall": 20.0, "held": 10, "compared": 10, "choice_holds": None},
+        {"role": "held-out", "held_out": True, "choice_within": False, "choice_measured_wall": 500.0,
+         "choice_predicted_wall": 600.0, "held": 10, "compared": 10, "choice_holds": None},
+        {"role": "held-out", "held_out": False, "choice_within": None, "choice_measured_wall": None,
+         "choice_predicted_wall": None, "held": 0, "compared": 0, "choice_holds": None},
+        {"role": "fit", "held_out": True, "choice_within": True, "choice_measured_wall": 1.0,
+         "choice_predicted_wall": 1.0, "held": 0, "compared": 5, "choice_holds": False},
+    ]
+    t = em.held_out_targets(entries, 0.01)
+    assert (t["held_out"], t["inside"], t["within"], t["held"], t["compared"]) == (4, 3, 2, 29, 30)
+    assert t["median_wall_s"] == pytest.approx(12.0) and (t["choices_measured"], t["choices_holding"]) == (1, 1)
 
 
 def test_cheapest_within_and_combined_error():
@@ -232,7 +256,7 @@ def test_held_out_scenes_are_predicted_from_the_fitting_set_only():
     out = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05)}
     e = out["dL0.5_W0.125_Lb1181"]
     assert e["role"] == "held-out" and e["held_out"] and (e["compared"], e["held"]) == (3, 0)
-    assert e["choice"] == "rod M100" and e["choice_holds"] is True
+    assert e["choice"] == "rod M100" and e["choice_within"] and e["choice_holds"] is True
     # the held-out row does not change what the fitting scenes predict for each other
     from ddg.advise import choose, parse_rows
     assert choose(0.1, 0.5, None, 0.05, rows=parse_rows(rows + [held])).predicted_errors["dW1"] == 0.02

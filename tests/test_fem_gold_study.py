@@ -202,10 +202,12 @@ def test_the_error_map_scenes_are_named_by_their_strip_and_run_only_when_asked()
     paper's ten scenes: a map scene runs only when named with --only."""
     from types import SimpleNamespace
 
-    from fem_reference.gold import MAP_SCENES, NEW_MAP_SCENES, all_scenes, check_gold_inputs, mesh_sequence, scenes
+    from fem_reference.gold import (HELD_OUT_SCENES, MAP_SCENES, NEW_MAP_SCENES, all_scenes, check_gold_inputs,
+                                    mesh_sequence, scenes)
 
     names = [name for name, *_ in all_scenes()]
-    assert len(names) == len(set(names)) == 10 + len(MAP_SCENES) + len(NEW_MAP_SCENES)
+    assert len(names) == len(set(names)) == 10 + len(MAP_SCENES) + len(NEW_MAP_SCENES) + len(HELD_OUT_SCENES)
+    assert {"dL0.4_W0.05", "dL0.3333_W0.125", "dL0.5_W0.05_Lb2000", "dL0.3_W0.25"} <= set(names)
     assert "dL0.5_W0.125" in names and "dL0.5_W0.05_Lb300" in names
     for _, _, width, _ in all_scenes():
         meshes = mesh_sequence(width)

@@ -162,7 +162,7 @@ def width_warnings(summary: dict, error_map=None) -> list[str]:
         return [f"{where}: outside the error map ({why}); the error of a 1D model, which misses what the "
                 "width adds, is not measured here: check against --model plate"]
     margin = cross_validated_margin(rows) if len(basis) > 1 else None
-    found = [p for p in predictions(rows, basis, {model}, 1.0 if margin is None else margin.value)
+    found = [p for p in predictions(rows, basis, here, {model}, 1.0 if margin is None else margin.value)
              if p.model == model]
     names = ", ".join(s.name for s in basis)
     values = [(p.errors["dW1"], p.label) for p in found if p.errors.get("dW1") is not None]

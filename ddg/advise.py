@@ -38,12 +38,20 @@ map nothing is predicted: the choice is the candidate most accurate at the neare
 (distance in log dL/L, log W/L, log relative L/b), at its node count or element size, labelled
 with an unknown error.
 
+What a prediction is checked against (measured_error): at a scene with a reference, the candidate's
+error |q - reference| (the q_error column; for H_mid the largest pointwise difference), where its
+row has a bound. The prediction is built from bounds (error + the basis references' error bars), so
+it claims the error against a converged reference; the checking scene's own reference error bar is
+reported beside it, not added to the measured error (which would count that bar twice, once in the
+basis bounds and once in the measurement: rule v2 compared bound with bound). Fixed with rule v3,
+before its held-out references existed.
+
 Cross-validated margin (rule v2, kept). Errors are not monotone in the scene: the plate on 8 rows
 is worse at W/L = 1/8 than at 1/12 and at 1/6, so the largest bound of the bracketing scenes can
 understate an interior scene's error. The margin is measured on the fitting scenes alone,
 leave-one-out: each fitting scene bracketed by the others is predicted from them (margin 1, the
-plates at the rows measured there), and the margin is the largest ratio measured bound / predicted
-bound over every (candidate, quantity) there, and at least 1 (cross_validated_margin). It is
+plates at the rows measured there), and the margin is the largest ratio measured error / predicted
+error over every (candidate, quantity) there, and at least 1 (cross_validated_margin). It is
 recomputed from whatever map is read, never from the held-out scenes. On a scene of the map itself
 (one basis scene: nothing interpolated) the bound measured there is the prediction, margin 1.
 
@@ -415,8 +423,9 @@ def compared_at(rows, scene: Scene, basis: list[Scene], runnable=None, margin: f
                 quantities=QUANTITIES) -> list[tuple[Prediction, str, float, float]]:
     """Leave one out: `scene`'s own rows are set aside, the other `rows` predict each candidate on
     `scene` from `basis` (times `margin`; the plates also at the rows measured at `scene`), and each
-    prediction meets the candidate's measured bound at `scene`: (prediction, quantity, predicted,
-    measured) wherever both exist."""
+    prediction meets the candidate's measured error at `scene` (module docstring: |q - reference|,
+    the q_error column, where the row has a bound, i.e. a complete run and a reference value with an
+    error bar): (prediction, quantity, predicted, measured) wherever both exist."""
     mine = {(r["model"], r["resolution_label"]): r for r in rows if at_scene(r, scene)}
     others = [r for r in rows if not at_scene(r, scene)]
     plate_rows = {int(r["resolution"]) for r in mine.values() if r["model"] in PLATE_MODELS}
@@ -426,16 +435,24 @@ def compared_at(rows, scene: Scene, basis: list[Scene], runnable=None, margin: f
         if row is None:
             continue
         for q in quantities:
-            predicted, measured = p.errors.get(q), row.get(f"{q}_bound")
+            predicted, measured = p.errors.get(q), measured_error(row, q)
             if predicted is not None and measured is not None:
                 out.append((p, q, predicted, measured))
     return out
 
 
+def measured_error(row, q: str) -> float | None:
+    """What a prediction of q is checked against at a scene: |q - reference| (the q_error column),
+    where the row has a bound (a complete run, a reference value with an error bar); else None."""
+    if row.get(f"{q}_bound") is None:
+        return None
+    return row.get(f"{q}_error")
+
+
 def cross_validated_margin(rows, runnable=None) -> Margin:
     """Leave-one-out on the fitting rows (held-out rows are dropped first): each scene bracketed
     by the others is predicted from them with margin 1; the margin is the largest ratio measured
-    bound / predicted bound over every (candidate, quantity) compared, and at least 1."""
+    error / predicted error over every (candidate, quantity) compared, and at least 1."""
     rows = fitting(rows)
     worst, where, compared, scenes = 1.0, "none above 1", 0, 0
     for scene in map_scenes(rows):

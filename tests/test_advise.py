@@ -22,7 +22,7 @@ def _row(c, w, lb, model, res, label, wall, bounds, reason=""):
     row = {"scene": f"dL{c:g}_W{w:.4g}_Lb{lb:.0f}", "compression_ratio": c, "width_ratio": w, "slenderness": lb,
            "model": model, "resolution": res, "resolution_label": label, "wall_time_s": wall, "reason": reason}
     for q, b in zip(QUANTITIES, bounds):
-        row.update({f"{q}_error": "" if b is None else b / 2, f"{q}_ref_error_bar": "" if b is None else b / 2,
+        row.update({f"{q}_error": "" if b is None else b, f"{q}_ref_error_bar": "" if b is None else 0.0,
                     f"{q}_bound": "" if b is None else b})
     return row
 

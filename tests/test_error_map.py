@@ -95,8 +95,8 @@ def _map_row(w, lb, model, label, wall, bound):
     row = {c: "" for c in em.COLUMNS}
     row.update(scene=f"dL0.5_W{w:.4g}_Lb{lb:.0f}", compression_ratio="0.5", width_ratio=repr(w), slenderness=repr(lb),
                model=model, resolution=label[1:], resolution_label=label, wall_time_s=repr(wall))
-    for q in em.QUANTITIES:
-        row[f"{q}_bound"] = repr(bound)
+    for q in em.QUANTITIES:   # a reference without error bar: error and bound the same
+        row[f"{q}_bound"] = row[f"{q}_error"] = repr(bound)
     return row
 
 
@@ -107,7 +107,7 @@ def test_held_out_check_leaves_each_scene_out():
     lb = 1181.1023622047244
     rows = [_map_row(w, lb, "rod", "M100", 1.0, b) for w, b in ((0.05, 0.004), (1 / 12, 0.006), (1 / 6, 0.02))]
     rows += [_map_row(w, lb, "rod", "M50", 0.5, b) for w, b in ((0.05, 0.003), (1 / 12, 0.006), (1 / 6, 0.008))]
-    rows[4]["dW2_bound"] = "0.03"
+    rows[4]["dW2_bound"] = rows[4]["dW2_error"] = "0.03"
     out = {e["scene"]: e for e in em.held_out_check(rows, 0.01)}
     edge, middle = out["dL0.5_W0.05_Lb1181"], out["dL0.5_W0.08333_Lb1181"]
     assert not edge["held_out"] and "outside" in edge["why"]
@@ -133,6 +133,24 @@ def test_the_margin_measured_on_the_fitting_scenes_is_carried_to_the_held_out_on
     assert (e1["compared"], e1["held"], e1["margin"]) == (3, 0, 1.0)
     assert (e3["compared"], e3["held"]) == (3, 3) and e3["margin"] == pytest.approx(1.5)
     assert v3["dL0.5_W0.08333_Lb1181"]["margin"] == 1.0 and v3["dL0.5_W0.08333_Lb1181"]["held"] == 0
+
+
+def test_a_prediction_is_checked_against_the_error_not_the_bound():
+    """The prediction (from bounds: error + the basis references' error bars) claims the error
+    against a converged reference; at the checking scene it meets |q - reference|, its reference's
+    own error bar reported, not added (rule v2 added it: the bar counted twice). A held-out rod
+    predicted 0.02 with error 0.015 and a reference error bar 0.01 (bound 0.025) holds."""
+    lb = 1181.1023622047244
+    rows = [_map_row(w, lb, "rod", "M100", 1.0, b) for w, b in ((0.05, 0.004), (1 / 6, 0.02))]
+    held = _map_row(0.125, lb, "rod", "M100", 1.0, 0.025)
+    held["role"] = "held-out"
+    for q in em.QUANTITIES:
+        held[f"{q}_error"], held[f"{q}_ref_error_bar"] = "0.015", "0.01"
+    e = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05)}["dL0.5_W0.125_Lb1181"]
+    assert (e["compared"], e["held"]) == (3, 3) and e["choice_measured"] == pytest.approx(0.015)
+    held["dW1_bound"] = ""      # no bound (e.g. a run that stopped): nothing to check on dW1
+    e = {e["scene"]: e for e in em.held_out_check(rows + [held], 0.05)}["dL0.5_W0.125_Lb1181"]
+    assert e["compared"] == 2
 
 
 def test_held_out_targets_count_scenes_choices_and_predictions():

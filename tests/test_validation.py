@@ -737,6 +737,9 @@ def test_the_ribbon_and_error_map_sections_render_from_the_map():
     assert [(r["model"], r["resolution"]) for r in wide] == [("rod", "M100"), ("ribbon-trapeze", "M101"),
                                                               ("plate", "R24")]
     assert [(r["on_dW1"], r["on_all_three"]) for r in enough] == [("rod M100", "none"), ("plate R16", "plate R16")]
+    # the map per tolerance (issue 32): nothing on the narrow scene before 0.09 (the rod's H_mid)
+    assert [(r["on_all_three_0_02"], r["on_all_three_0_05"]) for r in enough] == [
+        ("none", "ribbon-trapeze M101 (1.5 s)"), ("plate R16 (62 s)", "plate R16 (62 s)")]
     data = _hand_made_report()
     data.tables["wide_ribbons"] = Table("wide_ribbons", WIDE_COLUMNS, wide, csv=True)
     data.tables["enough"] = Table("enough", ENOUGH_COLUMNS, enough, csv=True)
@@ -747,6 +750,7 @@ def test_the_ribbon_and_error_map_sections_render_from_the_map():
             assert _html_row(row, table.shown_columns) in page, (table.name, row)
     assert "## 1D models with width" in md and "## Which model is enough (error map)" in md
     assert "1 of 2 scenes have a model within 0.01 L on all three; 2 on dW1 alone." in md
+    assert "within 0.02 L and 0.05 L on all three (1 and 2 scenes have one)" in md
 
 
 def test_the_force_comparison_is_relative_to_the_reference_force_and_split_by_range():

@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from ddg.advise import (NOT_RUN, QUANTITIES, RULE_V1_MARGIN, at_scene, basis_scenes, choose, compared_at,
-                        cross_validated_margin, fitting, map_scenes, parse_rows, scene_name)
+                        cross_validated_margin, fitting, map_scenes, measured_error, parse_rows, scene_name)
 from ddg.output.io import (StoredRun, atomic_write_text, finished_run_summary, finite_float, save_figure,
                           write_table_csv)
 from ddg.solve.probe import Probe
@@ -525,7 +525,8 @@ def held_out_check(rows: list[dict], tolerance: float = 0.01, quantities=QUANTIT
     "held-out": never in the fitting set) and, leave-one-out, each fitting scene S with S removed
     from the fitting set. If the fitting scenes bracket it, every candidate predicted there (the
     plates at the rows measured at S too) is compared on each of `quantities` with its measured error
-    + reference error bar at S (it holds where measured <= predicted), and advise's choice at
+    |q - reference| at S (ddg.advise.measured_error; it holds where measured <= predicted), and
+    advise's choice at
     `tolerance` is recorded: its verdict, predicted error and cost, and, where S has a row of it, its
     measured error and wall time. One dict per scene; scenes not bracketed without themselves say
     so. `rule` "v3": the cross-validated margin measured on the fitting scenes that remain (for a
@@ -565,7 +566,7 @@ def held_out_check(rows: list[dict], tolerance: float = 0.01, quantities=QUANTIT
         mine = [r for r in same if r["model"] == choice.model and r["resolution_label"] == choice.label]
         if mine:
             entry["choice_measured_wall"] = mine[-1].get("wall_time_s")
-            measured = [mine[-1].get(f"{q}_bound") for q in judged]
+            measured = [measured_error(mine[-1], q) for q in judged]
             if judged and None not in measured:
                 entry["choice_measured"] = max(measured)
                 entry["choice_holds"] = bool(max(measured) <= tolerance) if choice.within else None

@@ -678,8 +678,15 @@ WIDE_MODELS = (("rod", "M100"), ("ribbon", "M101"), ("ribbon-sano-wada", "M101")
 ENOUGH_TOLERANCE = 0.01
 WIDE_COLUMNS = ["compression_ratio", "width_ratio", "model", "resolution", "dW1_over_L", "dW2_over_L",
                 "ref_dW1", "ref_dW2", "dW1_error", "dW2_error", "H_mid_error", "wall_time_s", "reason"]
+def enough_column(tolerance: float) -> str:
+    """The enough table's column of the cheapest model within `tolerance` on all three quantities."""
+    return f"on_all_three_{tolerance:g}".replace(".", "_")
+
+
+#: The further tolerances of the "which model is enough" table (issue 32: the map per tolerance).
+ENOUGH_MORE_TOLERANCES = (0.02, 0.05)
 ENOUGH_COLUMNS = ["compression_ratio", "width_ratio", "slenderness", "on_dW1", "on_dW1_bound", "on_all_three",
-                  "on_all_three_bound", "wall_time_s"]
+                  "on_all_three_bound", "wall_time_s"] + [enough_column(t) for t in ENOUGH_MORE_TOLERANCES]
 
 
 def error_map_rows(path: Path | None = None) -> list[dict]:
@@ -822,10 +829,16 @@ def wide_ribbon_table(rows: list[dict]) -> list[dict]:
     return out
 
 
+def _cheapest_label(row: dict | None) -> str:
+    return "none" if row is None else f"{row['model']} {row['resolution_label']} ({float(row['wall_time_s']):.3g} s)"
+
+
 def enough_table(rows: list[dict], tolerance: float = ENOUGH_TOLERANCE) -> list[dict]:
     """Per map scene: the cheapest model ddg runs (the FEM left out) whose error plus the
     reference's error bar is within `tolerance` on dW1 alone and on dW1, dW2 and H_mid together
-    (validation.error_map.cheapest_within), with its bound and wall time; "none" where none is."""
+    (validation.error_map.cheapest_within), with its bound and wall time; "none" where none is; and
+    the cheapest on all three at each of ENOUGH_MORE_TOLERANCES (columns enough_column(tolerance):
+    on_all_three_0_02, ...)."""
     from .error_map import cheapest_within, combined_error
 
     out = []
@@ -841,7 +854,9 @@ def enough_table(rows: list[dict], tolerance: float = ENOUGH_TOLERANCE) -> list[
                     "on_dW1_bound": finite_float(dw1["dW1_bound"]) if dw1 else None,
                     "on_all_three": f"{all3['model']} {all3['resolution_label']}" if all3 else "none",
                     "on_all_three_bound": combined_error(all3) if all3 else None,
-                    "wall_time_s": finite_float(all3["wall_time_s"]) if all3 else None})
+                    "wall_time_s": finite_float(all3["wall_time_s"]) if all3 else None}
+                   | {enough_column(t): _cheapest_label(cheapest_within(mine, t, runnable_only=True))
+                      for t in ENOUGH_MORE_TOLERANCES})
     return out
 
 

@@ -53,7 +53,9 @@ ACCURACY_CASES = [
     ("dL0.25_W0.05_Lb787", "H_mid", 0.01, None),
     ("dL0.25_W0.08333_Lb787", "dW1", 0.005, "dW1 0.2024 against 0.2084: error 0.0060"),
     ("dL0.25_W0.08333_Lb787", "dW2", 0.005, None),
-    ("dL0.25_W0.08333_Lb787", "H_mid", 0.01, "H_mid error 0.0108"),
+    # 0.0108 under the map's rules version 2; 0.0097 under version 3 (issue 32: the band about the
+    # run's own thresholds left out too, a rule change made for every model, not for this case)
+    ("dL0.25_W0.08333_Lb787", "H_mid", 0.01, None),
     ("dL0.5_W0.1667_Lb1181", "dW1", 0.01, "dW1 0.2421 against 0.2654: error 0.0232"),
     ("dL0.5_W0.1667_Lb1181", "dW2", 0.01, "no dW2: the path stops in US (the shell's 0.4308)"),
     ("dL0.25_W0.1667_Lb787", "dW1", 0.01, "dW1 0.1467 against 0.1610: error 0.0142"),

@@ -354,8 +354,9 @@ def _committed():
 def test_committed_map_narrow_strip_at_lb_300(monkeypatch):
     """Issue 17: `auto` picks the rod for W/L = 1/20 at L/b = 300 and tolerance 0.01 *if the map says so*.
     The committed map measures the rod there (M = 50/100/200) at dW1 error + reference error bar
-    0.0190-0.0197 (rod dW1 0.3564-0.3571 against the FEM's 0.3393 +- 0.0019): not within 0.01, so the
-    rod is not chosen; whatever is chosen is predicted within 0.01 or is the safe choice."""
+    0.0226-0.0233 (rod dW1 0.3563-0.3570 against the FEM's 0.3392 +- 0.0055, a three-mesh study since
+    issue 28): not within 0.01, so the rod is not chosen; whatever is chosen is predicted within 0.01
+    or labelled as not within."""
     monkeypatch.delenv("DDG_ERROR_MAP", raising=False)
     rows = _committed()
     rods = [r for r in rows if r["model"] == "rod" and r["scene"] == "dL0.5_W0.05_Lb300"]
@@ -365,7 +366,7 @@ def test_committed_map_narrow_strip_at_lb_300(monkeypatch):
     c = choose(0.05, 0.5, 300.0, 0.01, runnable=set(ddg.api.DEFAULT_RESOLUTION))
     assert (c.model == "rod") == rod_within
     assert not rod_within   # what the committed map says (see the docstring)
-    assert c.safe or all(c.predicted_errors[q] <= 0.01 for q in QUANTITIES)
+    assert not c.within or all(c.predicted_errors[q] <= 0.01 for q in QUANTITIES)
 
 
 def test_committed_map_wide_strip_gets_a_plate(monkeypatch):
@@ -374,7 +375,20 @@ def test_committed_map_wide_strip_gets_a_plate(monkeypatch):
     for compression in (0.5, 0.25):
         c = choose(0.5, compression, None, 0.01, runnable=set(ddg.api.DEFAULT_RESOLUTION))
         assert c.model in ("plate", "plate-midedge")
-        assert c.safe or all(c.predicted_errors[q] <= 0.01 for q in QUANTITIES)
+        assert not c.within or all(c.predicted_errors[q] <= 0.01 for q in QUANTITIES)
+
+
+def test_committed_map_default_scene_at_0_02_gets_a_model_predicted_within_at_under_30_s(monkeypatch):
+    """Issue 32: at the default scene (W/L = 1/20, dL/L = 1/2, the paper's strip) and tolerance 0.02
+    the choice is predicted within 0.02 on all three quantities, at a map cost under 30 s (the
+    measured wall time of that run is benchmarks/results/auto_choice.md's, not asserted here). On
+    the committed map: ribbon-cross-section M201, predicted 0.0051 / 0.0022 / 0.0164, 19.8 s; the
+    rod misses on dW2 (0.0486) and H_mid (0.0942), the mid-edge plate on 8 rows is within at 130 s."""
+    monkeypatch.delenv("DDG_ERROR_MAP", raising=False)
+    _committed()
+    c = choose(0.05, 0.5, None, 0.02, runnable=set(ddg.api.DEFAULT_RESOLUTION))
+    assert c.within and c.inside_map and c.unknown == {}
+    assert all(c.predicted_errors[q] <= 0.02 for q in QUANTITIES) and c.wall_time_s < 30.0, (c.model, c.label)
 
 
 def test_a_choice_outside_the_map_runs_one_model_and_says_its_error_is_unknown(map_csv, tmp_path, monkeypatch):

@@ -267,7 +267,8 @@ def basis_scenes(rows, scene: Scene) -> tuple[list[Scene], str]:
         widths = _bracket([s.width_ratio for s in at_c], scene.width_ratio)
         if widths is None:
             lo, hi = min(s.width_ratio for s in at_c), max(s.width_ratio for s in at_c)
-            return [], f"W/L = {scene.width_ratio:.4g} is outside the map's range [{lo:.4g}, {hi:.4g}] at dL/L = {c:.4g}"
+            return [], (f"W/L = {scene.width_ratio:.4g} is outside the map's range [{lo:.4g}, {hi:.4g}] at "
+                        f"dL/L = {c:.4g}")
         for w in widths:
             at = [s for s in at_c if _same(s.width_ratio, w)]
             relative = _bracket([s.relative_slenderness for s in at], scene.relative_slenderness)
@@ -505,7 +506,8 @@ class Choice:
             return f"predicted within {self.tolerance:g}"
         if not self.inside_map:
             return "OUTSIDE THE MAP: error unknown"
-        return f"NOT WITHIN THE TOLERANCE {self.tolerance:g}: the most accurate candidate, predicted {_fmt(self.worst())}"
+        return (f"NOT WITHIN THE TOLERANCE {self.tolerance:g}: the most accurate candidate, predicted "
+                f"{_fmt(self.worst())}")
 
     def worst(self) -> float | None:
         values = [self.predicted_errors.get(q) for q in self.quantities if q not in self.unknown]

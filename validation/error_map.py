@@ -23,9 +23,10 @@ the reference curve's dW grid inside the run's range and more than THRESHOLD_BAN
 reference's dW1 and dW2 and from the run's own (validation.claims; a small shift of a threshold is
 a large H_mid difference there, and the thresholds' own errors are the dW1 and dW2 columns), the
 largest |H_mid - reference| (H_mid_error), the largest reference error bar (H_mid_ref_error_bar)
-and the largest pointwise sum (H_mid_bound, as validation.estimates.Study.mesh_error); the wall time of the run (summary.json wall_time_s: path and thresholds) and a
-reason where a value is missing. A bound is left empty where the run did not complete its path
-(its comparison would cover part of the path only). ddg.advise reads the q_bound columns.
+and the largest pointwise sum (H_mid_bound, as validation.estimates.Study.mesh_error); the wall
+time of the run (summary.json wall_time_s: path and thresholds) and a reason where a value is
+missing. A bound is left empty where the run did not complete its path (its comparison would cover
+part of the path only). ddg.advise reads the q_bound columns.
 
 Resumable: a row is written to OUT/error_map.csv (atomically, the whole table) as soon as it is
 computed; a rerun keeps a row whose model, resolution and scene match with the same source hash
@@ -691,7 +692,8 @@ def held_out_section(rows: list[dict], held: dict) -> list[str]:
     for tol, entries in held.items():
         t = held_out_targets(entries, tol)
         share = "–" if not t["inside"] else f"{100 * t['within'] / t['inside']:.0f} %"
-        holds = "–" if not t["compared"] else f"{t['held']} of {t['compared']} ({100 * t['held'] / t['compared']:.1f} %)"
+        holds = ("–" if not t["compared"] else
+                 f"{t['held']} of {t['compared']} ({100 * t['held'] / t['compared']:.1f} %)")
         lines.append(f"| {tol:g} | {t['held_out']} | {t['inside']} | {t['within']} ({share}) | "
                      f"{_num(t['median_wall_s'], '{:.3g}')} | {holds} | {t['choices_holding']} of "
                      f"{t['choices_measured']} |")
@@ -777,8 +779,8 @@ def figures(rows: list[dict], out: Path, tolerance: float = 0.01) -> list[str]:
     axes[0, 0].set_ylabel("max over dW1, dW2, H_mid of\nerror + reference error bar (/L)", fontsize=8)
     handles = [plt.Line2D([], [], ls="", marker=_marker(m), color=colours[m], label=m) for m in models]
     fig.legend(handles=handles, loc="upper center", ncol=len(models), fontsize=7, frameon=False)
-    fig.text(0.01, 0.01, "the paper's L/b only; filled: dL/L = 1/2, open: smaller; faint at 1: a quantity missing; dashed: "
-             f"{tolerance:g}", fontsize=6)
+    fig.text(0.01, 0.01, "the paper's L/b only; filled: dL/L = 1/2, open: smaller; faint at 1: a quantity missing; "
+             f"dashed: {tolerance:g}", fontsize=6)
     fig.tight_layout(rect=(0, 0.03, 1, 0.9))
     save_figure(fig, out / "speed_accuracy.png", dpi=90)
     plt.close(fig)

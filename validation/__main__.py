@@ -1,4 +1,5 @@
-"""python -m validation report [--quick | --full] [--out DIR] [--jobs N] [--scheduler ADDRESS] [--quiet]"""
+"""python -m validation report [--quick | --full] [--out DIR] [--jobs N] [--scheduler ADDRESS] [--quiet]
+python -m validation score RESULTS [--out DIR] | --template FILE | --benchmark DIR  (validation/score.py)"""
 from __future__ import annotations
 
 import argparse
@@ -19,15 +20,30 @@ def main(argv=None) -> int:
     rep.add_argument("--scheduler", default=None,
                      help="an existing Dask scheduler for the runs, e.g. tcp://host:8786 (default: a local cluster)")
     rep.add_argument("--quiet", action="store_true", help="no progress bar")
+    score = sub.add_parser("score", help="score another code's thresholds and H_mid curves (a CSV file) against "
+                                         "the FEM benchmark: DIR/score.csv, score.md, score.png")
+    score.add_argument("results", nargs="?", default=None, metavar="RESULTS",
+                       help="the CSV file to score (format: validation/score.py, or write a template with --template)")
+    score.add_argument("--out", default="out/score", help="output directory (default out/score)")
+    score.add_argument("--template", default=None, metavar="FILE",
+                       help="write a RESULTS template with a row per benchmark scene to FILE and exit")
+    score.add_argument("--benchmark", default=None, metavar="DIR",
+                       help="write the benchmark (benchmark.csv, benchmark_H_mid.csv, README.md) to DIR and exit")
     args = parser.parse_args(argv)
+    if args.command == "score":
+        from .score import run
+
+        return run(args)
     if args.jobs < 1:
         sys.stderr.write(f"error: --jobs = {args.jobs} must be >= 1\n")
         return 2
     from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
 
     from .report import MissingExtra, build_report
 
     try:
+        check_output_directory(args.out, "--out")   # before any run: an existing file is one line, not a traceback
         summary = build_report(args.profile or "quick", args.out, jobs=args.jobs, progress=not args.quiet,
                                scheduler=args.scheduler)
     except (MissingExtra, InputError) as exc:

@@ -255,27 +255,48 @@ def test_held_out_scenes_are_predicted_from_the_fitting_set_only():
 #: tolerances 0.01 and 0.02, a model predicted within at >= 80 % of the scenes inside the map, the
 #: median wall time of those choices <= 30 s, measured <= predicted in >= 95 % of the predictions.
 TARGET_WITHIN, TARGET_MEDIAN_WALL_S, TARGET_HOLDING = 0.80, 30.0, 0.95
+HELD_OUT_NAMES = {"dL0.4_W0.05_Lb984", "dL0.3333_W0.125_Lb886", "dL0.5_W0.05_Lb2000", "dL0.3_W0.25_Lb844"}
 
 
 def _targets(tolerance):
     rows = committed_rows()
-    if not any(r.get("role") == "held-out" for r in rows):
-        pytest.fail("the committed map has no held-out scene: issue 32's check needs them")
+    assert {r["scene"] for r in rows if r.get("role") == "held-out"} == HELD_OUT_NAMES
     return em.held_out_targets(em.held_out_check(rows, tolerance), tolerance)
-
-
-HELD_OUT_CASES = []   # (tolerance, target, figures when not met) — filled from the committed map
 
 
 @pytest.mark.parametrize("tolerance", [0.01, 0.02])
 def test_issue_32_predictions_hold_on_the_held_out_scenes(tolerance):
+    """Measured |q - reference| <= predicted in >= 95 % of (scene, candidate, quantity) predictions on
+    the four held-out scenes, all inside the map: 116 of 117 (99.1 %; the miss: ribbon-trapeze M = 51's
+    dW1 at dL/L = 0.4, measured 0.0423 against 0.0420 predicted)."""
     t = _targets(tolerance)
-    assert t["inside"] > 0 and t["held"] >= TARGET_HOLDING * t["compared"], t
+    assert t["inside"] == 4 and t["held"] >= TARGET_HOLDING * t["compared"], t
+
+
+@pytest.mark.xfail(strict=True, reason="issue 32's target not met: a model is predicted within 0.01 (and within "
+                                       "0.02) at 1 of the 4 held-out scenes (25 %; bound 80 %): the mid-edge plate on "
+                                       "8 rows at dL/L = 0.4 (predicted 0.0052, measured 0.0029); elsewhere the best "
+                                       "is predicted 0.0363 (W/L = 1/8 and 1/4 at dL/L = 1/3 and 0.3) and 0.0618 "
+                                       "(L/b = 2000)")
+@pytest.mark.parametrize("tolerance", [0.01, 0.02])
+def test_issue_32_a_model_is_predicted_within_the_tolerance_at_80_percent_of_held_out_scenes(tolerance):
+    t = _targets(tolerance)
+    assert t["within"] >= TARGET_WITHIN * t["inside"], t
+
+
+@pytest.mark.xfail(strict=True, reason="issue 32's target not met: the one choice predicted within 0.01 and 0.02, "
+                                       "the mid-edge plate on 8 rows at dL/L = 0.4, took 175 s in its held-out study "
+                                       "(run at nice 19 beside the shell; 36 s at the default scene in "
+                                       "benchmarks/results/auto_choice.md), bound 30 s")
+@pytest.mark.parametrize("tolerance", [0.01, 0.02])
+def test_issue_32_the_median_wall_time_of_those_choices_is_under_30_s(tolerance):
+    t = _targets(tolerance)
+    assert t["median_wall_s"] is not None and t["median_wall_s"] <= TARGET_MEDIAN_WALL_S, t
 
 
 def test_committed_map_held_out_scenes_are_those_with_a_finished_study():
-    """The held-out scenes of fem_reference.gold.MAP_SCENES (W/L = 1/8, 1/4) are in the map once their
-    FEM study is finished; when the map was committed none was (their runs were in progress)."""
+    """The held-out scenes (fem_reference.gold.HELD_OUT_SCENES) are in the map once their FEM study is
+    finished, and only then."""
     rows = committed_rows()
     held = {r["scene"] for r in rows if r.get("role") == "held-out"}
     finished = {s.name for s in em.reference_scenes() if s.role == "held-out" and s.reference is not None}

@@ -271,8 +271,9 @@ def simulate(
     studies that read only path.csv and summary.json (the gold and mesh studies in data/).
     model="auto" with `tolerance` (units of L; `quantities` of dW1, dW2, H_mid, default all;
     `error_map` a CSV, default $DDG_ERROR_MAP or data/error_map/error_map.csv): the cheapest
-    model and resolution the error map predicts within the tolerance on this scene, or the safe
-    choice outside the map (ddg.advise; simulate_auto), run; summary key `auto` says why.
+    model and resolution the error map predicts within the tolerance on this scene, else the most
+    accurate one labelled as not within it (outside the map: error unknown; ddg.advise rule v3,
+    simulate_auto), run; summary key `auto` says which and why.
     """
     _checked_scene(strip, protocol)
     requested_blas_threads()   # DDG_BLAS_THREADS refused before any work

@@ -64,7 +64,8 @@ from ddg.solve.probe import Probe
 
 from .claims import THRESHOLD_BAND
 from .benchmark import fraction_label
-from .estimates import MIDEDGE_GOLD, PLATE_GOLD, Study, away_from, load_study, study_from_runs
+from .estimates import (MIDEDGE_GOLD, PLATE_GOLD, Study, difference_away_from_thresholds, load_study,
+                        study_from_runs)
 from .reference import FEM_GOLD, ROOT, gold_name
 
 try:   # the error map's reference scenes beyond the paper's ten (fem_reference.gold; no dolfinx needed)
@@ -284,12 +285,12 @@ def row_errors(reference: Study | None, summary: dict, rows: list[dict]) -> dict
         # either, H_mid jumps (US -> S) or turns (U -> US), and a threshold error shows as an H_mid
         # error of order the jump; the thresholds are measured by their own quantities
         own = [summary.get(f"{k}_over_L") for k in ("dW1", "dW2")]
-        keep = (away_from(curve.dw, list(reference.thresholds()) + own, THRESHOLD_BAND) & (curve.dw >= dw[0])
-                & (curve.dw <= dw[-1]))
+        keep, signed = difference_away_from_thresholds(curve, list(reference.thresholds()) + own, dw, h,
+                                                       THRESHOLD_BAND)
         if not np.any(keep):
             reasons.append("H_mid: no reference point inside the run's range away from the thresholds")
         else:
-            diff = np.abs(np.interp(curve.dw[keep], dw, h) - curve.value[keep])
+            diff = np.abs(signed)
             bar = curve.error_bar[keep]
             out["H_mid_error"] = float(diff.max())
             out["H_mid_ref_error_bar"] = float(bar.max())

@@ -177,6 +177,17 @@ def away_from(dw: np.ndarray, thresholds, band: float) -> np.ndarray:
     return keep
 
 
+def difference_away_from_thresholds(curve: Curve, thresholds, dw: np.ndarray, h: np.ndarray,
+                                    band: float) -> tuple[np.ndarray, np.ndarray]:
+    """A run's H_mid curve (dw ascending, h) against a reference curve, as the error map and the
+    scorecard compare them: the reference points inside the run's dW range and more than `band` from
+    every one of `thresholds` (the reference's and the run's own: near either H_mid turns or jumps,
+    and a threshold's shift is scored by its own quantity), as a mask on curve.dw, and the run's H
+    linearly interpolated there minus the reference (signed, on the masked points only)."""
+    keep = away_from(curve.dw, thresholds, band) & (curve.dw >= dw[0]) & (curve.dw <= dw[-1])
+    return keep, np.interp(curve.dw[keep], dw, h) - curve.value[keep]
+
+
 def _curve(entries) -> Curve | None:
     points = [(c["dW_over_L"], c["value"], c["error_bar"], np.nan if c.get("order") is None else c["order"],
                bool(c.get("asymptotic"))) for c in entries or []

@@ -77,7 +77,7 @@ from ddg.output.io import atomic_write_text, check_output_directory, save_figure
 
 from .benchmark import basis_meshes, estimate_basis, fraction_label
 from .claims import THRESHOLD_BAND
-from .estimates import Estimate, Study, away_from, load_study
+from .estimates import Estimate, Study, difference_away_from_thresholds, load_study
 from .reference import FEM_GOLD, ROOT
 
 #: The benchmark's release: bump it when its scenes or values change (a new or extended mesh study in
@@ -455,12 +455,10 @@ def curve_score(scene: BenchmarkScene, submitted: SubmittedScene | None) -> Scor
         return _with(base, note="the submitted curve has one point; two or more are needed")
     dw, h = (np.array(v) for v in zip(*sorted((p[0], p[1]) for p in submitted.curve)))
     own = [submitted.dW1, submitted.dW2]
-    keep = (away_from(curve.dw, scene.study.thresholds() + own, THRESHOLD_BAND)
-            & (curve.dw >= dw[0]) & (curve.dw <= dw[-1]))
+    keep, difference = difference_away_from_thresholds(curve, scene.study.thresholds() + own, dw, h, THRESHOLD_BAND)
     if not np.any(keep):
         return _with(base, note=f"no benchmark point inside the submitted curve's range (dW/L {dw[0]:g} to "
                                 f"{dw[-1]:g}) more than {THRESHOLD_BAND:g} from the thresholds")
-    difference = np.interp(curve.dw[keep], dw, h) - curve.value[keep]
     bar = np.maximum(curve.error_bar[keep], H_MID_ERROR_BAR_FLOOR)
     worst = int(np.argmax(np.abs(difference)))
     note = (f"largest |difference| at dW/L = {curve.dw[keep][worst]:.4f} of {int(keep.sum())} points; "

@@ -35,11 +35,15 @@ extensions = [
     "sphinx.ext.viewcode",
     "numpydoc",
     "sphinx_gallery.gen_gallery",
+    "myst_parser",   # the findings pages (docs/findings/*.md) are Markdown, moved from the README
     "ddg_docs",   # _ext/ddg_docs.py: command-help directive, docstring fallback, gallery titles
 ]
 
 root_doc = "index"
-source_suffix = {".rst": "restructuredtext"}
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+# MyST: "$...$" is not maths in the findings pages (they write formulas as plain text); tables, fenced code
+# and {doc} roles are core; headings get anchors for links of the form page.md#heading
+myst_heading_anchors = 3
 exclude_patterns = ["_build", "**.ipynb_checkpoints", "auto_examples/*.ipynb", "auto_examples/*.py",
                     "auto_examples/*.zip", "auto_examples/*.md5", "auto_examples/*.pickle"]
 templates_path: list[str] = []

@@ -2,7 +2,7 @@
 
 The default scene: a strip with W/L = 1/20, compressed by dL/L = 1/2 so that it buckles into a U,
 then sheared sideways up to dW_max. The rod (M = 100 nodes) writes its run folder as the output
-contract says (README, "Outputs"): path.csv, one row per recorded equilibrium, and summary.json.
+contract says (docs/reference/output_contract.rst): path.csv, one row per recorded equilibrium, and summary.json.
 Here path.csv is read with plain pandas, as any other tool would read it, and the run's story is
 checked on the table: U up to dW1, then the asymmetric US, then S from dW2.
 

@@ -7,7 +7,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export DEBIAN_FRONTEND=noninteractive
-APT_PACKAGES="python3 python3-venv python3-pip python3-numpy python3-scipy python3-numba python3-dolfinx python3-slepc4py python3-gmsh gmsh python3-meshio python3-matplotlib python3-jinja2 python3-dask python3-distributed python3-pandas chromium libegl1 libegl-mesa0 libopenblas0-pthread python3-sphinx python3-numpydoc python3-sphinx-gallery furo"
+APT_PACKAGES="python3 python3-venv python3-pip python3-numpy python3-scipy python3-numba python3-dolfinx python3-slepc4py python3-gmsh gmsh python3-meshio python3-matplotlib python3-jinja2 python3-dask python3-distributed python3-pandas chromium libegl1 libegl-mesa0 libopenblas0-pthread python3-sphinx python3-numpydoc python3-sphinx-gallery python3-myst-parser furo"
 missing=""
 for p in $APT_PACKAGES; do dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"; done
 if [ -n "$missing" ]; then

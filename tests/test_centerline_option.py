@@ -1,4 +1,4 @@
-"""centerline.csv stays part of a normal run's output (README "Outputs"); the mesh studies, which
+"""centerline.csv stays part of a normal run's output (docs/reference/output_contract.rst); the mesh studies, which
 read only path.csv and summary.json, leave it out with centerline=False (`--no-centerline`), and
 nothing else of the run changes (issue 28, item 5)."""
 import json

@@ -223,7 +223,7 @@ def test_committed_map_covers_every_scene_with_a_reference():
 def test_committed_map_leave_one_out():
     """Leave-one-scene-out on the fitting scenes (rule v3, nested margin): the scenes bracketed by the
     others are the interior ones of the box (dL/L, W/L, relative L/b); every prediction made there
-    bounds the error measured (339 of 339 on the map of issue 32; the README reports them)."""
+    bounds the error measured (339 of 339 on the map of issue 32; docs/findings/model_choice.md reports them)."""
     entries = [e for e in em.held_out_check(committed_rows(), 0.01) if e["role"] == "fit"]
     inside = {e["scene"] for e in entries if e["held_out"]}
     assert inside == {"dL0.5_W0.05_Lb1181", "dL0.5_W0.08333_Lb1181", "dL0.5_W0.1_Lb1181", "dL0.5_W0.125_Lb1181",

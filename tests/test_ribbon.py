@@ -21,7 +21,7 @@ from ddg.api import run_ribbon
 
 STRIP = ddg.Strip.from_ratios(0.05, 0.5)
 L = STRIP.length
-ROD_DW1 = 0.3516  # README: rod thresholds, W/L = 1/20, dL/L = 1/2, M = 100
+ROD_DW1 = 0.3516  # docs/findings/measured.md: rod thresholds, W/L = 1/20, dL/L = 1/2, M = 100
 M = 101
 
 

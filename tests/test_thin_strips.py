@@ -77,7 +77,7 @@ def test_the_finer_plate_completes_the_thin_path():
     """On 5740 triangles the crease near the clamps is resolved further: the path is complete
     (measured: dW1 0.3565, dW2 0.4535 at a fold, resolved up to dW/L 0.7834, 77 s beside another
     run). The thresholds move by 0.03 L from 2100 triangles: at L/b = 4000 the plate's mesh
-    error is large, a locking plate's (README, membrane locking)."""
+    error is large, a locking plate's (docs/findings/benchmark.md, membrane locking)."""
     s = ddg.simulate(SCENE, ddg.LoadingProtocol(0.5), model="plate", resolution=5740, branches=False).summary
     assert s["status"] == "complete"
     assert s["dW1_over_L"] < FOLD_OF_US < s["dW2_over_L"]

@@ -35,7 +35,7 @@ def _stored_rows():
 
 
 def test_stored_check_the_mid_edge_U_branch_stiffens_towards_the_shell_with_rows():
-    """data/midedge_wide (the README's W/L = 1/2 paragraph): the plate's clamp force at dW/L = 0.02
+    """data/midedge_wide (docs/findings/benchmark.md, the W/L = 1/2 paragraph): the plate's clamp force at dW/L = 0.02
     rises with the rows across W and stays below the shell's finest mesh, and on 54 rows dW1 is
     nearer the FEM's than on 36: the mid-edge meshes are the unconverged side."""
     rows = _stored_rows()

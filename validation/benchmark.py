@@ -198,7 +198,9 @@ def _number(value, spec: str = "{:.4f}") -> str:
     return MISSING if value is None else spec.format(value)
 
 
-def _with_bar(value, error_bar) -> str:
+def with_bar(value, error_bar) -> str:
+    """A converged value with its error bar, "0.3511 \u00b1 0.0012" (the value alone without a bar,
+    MISSING without a value): the benchmark's cells here and in the validation report's summary."""
     if value is None:
         return MISSING
     return _number(value) if error_bar is None else f"{value:.4f} \u00b1 {error_bar:.4f}"
@@ -215,15 +217,15 @@ def markdown_table(rows: list[dict]) -> str:
         cells = [fraction_label(r["compression_ratio"]), fraction_label(r["width_ratio"]),
                  _number(r["width_squared_over_thickness_length"], "{:.1f}")]
         for key in THRESHOLDS:
-            cells += [_with_bar(r[f"fem_{key}"], r[f"fem_{key}_error_bar"]),
-                      _with_bar(r[f"plate_{key}"], r[f"plate_{key}_error_bar"]),
+            cells += [with_bar(r[f"fem_{key}"], r[f"fem_{key}_error_bar"]),
+                      with_bar(r[f"plate_{key}"], r[f"plate_{key}_error_bar"]),
                       _number(r[f"{key}_in_error_bars"], "{:.1f}"),
-                      _with_bar(r[f"midedge_{key}"], r[f"midedge_{key}_error_bar"]),
+                      with_bar(r[f"midedge_{key}"], r[f"midedge_{key}_error_bar"]),
                       _number(r[f"midedge_{key}_in_error_bars"], "{:.1f}")]
         cells += [_number(r["paper_dW1"]), _number(r["paper_dW2"]),
-                  _with_bar(r["rod_dW1"], r["rod_dW1_error_bar"]), _with_bar(r["rod_dW2"], r["rod_dW2_error_bar"]),
-                  _with_bar(r["cross_section_dW1"], r["cross_section_dW1_error_bar"]),
-                  _with_bar(r["cross_section_dW2"], r["cross_section_dW2_error_bar"])]
+                  with_bar(r["rod_dW1"], r["rod_dW1_error_bar"]), with_bar(r["rod_dW2"], r["rod_dW2_error_bar"]),
+                  with_bar(r["cross_section_dW1"], r["cross_section_dW1_error_bar"]),
+                  with_bar(r["cross_section_dW2"], r["cross_section_dW2_error_bar"])]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -238,7 +240,7 @@ def basis_counts(rows: list[dict], prefix: str = "fem") -> dict:
 
 
 def basis_sentence(rows: list[dict]) -> str:
-    """One sentence counting the bases of the FEM and plate entries (benchmark.md, README)."""
+    """One sentence counting the bases of the FEM and plate entries (benchmark.md, the README)."""
     parts = []
     for prefix, name in (("fem", "FEM"), ("plate", "plate"), ("midedge", "mid-edge plate")):
         c = basis_counts(rows, prefix)

@@ -12,7 +12,7 @@ runs, at each L/b, the FEM shell (fem_reference simulate, 64 x 8 and 96 x 12 ele
 plate (exactly equilateral meshes of 8 and 12 rows), the rod (M = 100, 200; it depends on L/b
 through its in-plane bending stiffness only, (W/b)^2 times its out-of-plane one) and the 1D model
 with its cross-section (ribbon-cross-section, M = 101, 201; issue 30) through the
-README's path (40 compression and 120 shear steps to dW_max, no branch tracing) into
+the default path (docs/guide/run_a_scene.rst: 40 compression and 120 shear steps to dW_max, no branch tracing) into
 OUT/Lb<L/b>/<model>_<mesh>/ (path.csv, summary.json; at the paper's L/b the FEM and plate runs are
 those of data/fem_gold and data/plate_gold), then writes OUT/narrow_limit.json and
 OUT/narrow_limit.md: dW1/L and dW2/L per model and mesh, with W^2/(b L). Resumable run by run

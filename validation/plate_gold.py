@@ -9,7 +9,7 @@ with the plate on LEVELS exactly equilateral meshes (ddg.geometry.plate_mesh.equ
 refined uniformly by 1.5: BASE_ROWS[W/L] rows of triangles across W, then 1.5 and 2.25 times as
 many (every spacing divided by 1.5 each time;
 the default structured mesh cannot refine uniformly, its column count must stay odd). Each run
-is the README's path (40 compression and 120 shear steps to dW_max, thresholds located, no
+is the default path (docs/guide/run_a_scene.rst: 40 compression and 120 shear steps to dW_max, thresholds located, no
 branch tracing) into OUT/<scene>/R<rows>/ (path.csv, summary.json; no centerline.csv, which no
 study reads); after each run the scene's study is rewritten with the same estimates as the FEM gold
 (fem_reference.convergence.study_estimates: Richardson with the observed order and a grid

@@ -288,18 +288,23 @@ def evaluate(key: str, measured, missing: str = "", needs: str = "") -> dict:
     where a curve's reference stops short of the compared range. A claim without a finite measured
     value fails (reason "no data: ..."): the report cannot claim an agreement it did not measure.
     `missing` says what was missing (the runs or reference data); `needs`, the resolution each model
-    needs for the claim (resolution_needed)."""
+    needs for the claim (resolution_needed). A cross-model verdict also keeps the point that decides
+    its outcome (Agreement.deciding: `deciding_difference`, `deciding_error_bar`, against the bound and
+    `error_bar_limit`) and `stops_short`, where a curve's reference stops short of the range ("" if
+    nowhere): the report's one-line summary of the claim states these."""
     claim = CLAIMS[key]
     out = {"claim": key, "statement": claim.statement, "bound": claim.bound, "measured": None, "holds": False,
            "outcome": "fails", "reason": "", "difference": None, "combined_error_bar": None,
-           "in_error_bars": None, "needs": needs}
+           "in_error_bars": None, "needs": needs, "error_bar_limit": claim.error_bar_limit,
+           "deciding_difference": None, "deciding_error_bar": None, "stops_short": ""}
     if isinstance(measured, Agreement):
         outcome, (diff, combined, where) = measured.deciding(claim)
         if measured.short:
             outcome = "fails"
         out.update(measured=measured.difference, difference=measured.difference,
                    combined_error_bar=measured.combined_error_bar, in_error_bars=measured.in_error_bars,
-                   outcome=outcome, holds=outcome == "holds")
+                   outcome=outcome, holds=outcome == "holds", deciding_difference=diff,
+                   deciding_error_bar=combined, stops_short=measured.short)
         decidable = combined <= claim.error_bar_limit
         within = diff <= claim.bound
         point = (f"difference {diff:.4g} ({'<=' if within else '>'} bound {claim.bound:g}), combined error bar "

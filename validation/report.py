@@ -64,6 +64,12 @@ def cell(value) -> str:
     return str(value)
 
 
+#: What the report folds (layout only): a table cell longer than `cell` characters shows its first
+#: `preview` characters and folds the whole text in <details>; a table or list of more than `rows`
+#: entries is folded whole (the templates' macros fold, the summary at the top never is).
+FOLD = {"cell": 80, "preview": 40, "rows": 12}
+
+
 _CODE = re.compile(r"`([^`]+)`")
 _BOLD = re.compile(r"\*\*(.+?)\*\*")
 _LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
@@ -92,6 +98,7 @@ def _environment(html: bool):
     env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES), autoescape=html, trim_blocks=True,
                              lstrip_blocks=True, keep_trailing_newline=True, undefined=jinja2.StrictUndefined)
     env.filters.update(cell=cell, frac=fraction, fmt=format, md=inline_markdown if html else (lambda t: t))
+    env.globals["FOLD"] = FOLD
     return env
 
 

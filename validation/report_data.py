@@ -82,6 +82,14 @@ class FigureData:
     def png_base64(self) -> str:
         return base64.b64encode(self.png or b"").decode()
 
+    @property
+    def png_size(self) -> tuple[int, int] | None:
+        """(width, height) in pixels of the drawn PNG (its IHDR chunk), None before it is drawn: the
+        HTML gives its image this size so the page is laid out before the image loads."""
+        if not self.png or self.png[:8] != b"\x89PNG\r\n\x1a\n" or len(self.png) < 24:
+            return None
+        return int.from_bytes(self.png[16:20], "big"), int.from_bytes(self.png[20:24], "big")
+
     def records(self) -> list[dict]:
         return [dict(zip(self.columns, row)) for row in self.rows]
 
@@ -149,6 +157,41 @@ class ReportData:
     @property
     def unusual_outcomes(self) -> list[dict]:
         return unusual_outcomes(self.tables["stability_map"].rows)
+
+    @property
+    def disagreement_entries(self) -> int:
+        """How many entries the list of disagreements has: the paper's, the unusual outcomes, the
+        material check and its mesh trend (the templates fold a long list)."""
+        material = 0 if self.material is None else 1 + (self.material.mesh_trend is not None)
+        return len(self.paper_disagreements) + len(self.unusual_outcomes) + material
+
+    @property
+    def summary_figure(self) -> FigureData | None:
+        """The figure the summary shows (SUMMARY_FIGURE), None where this report has none."""
+        return next((f for f in self.figures if f.name == SUMMARY_FIGURE), None)
+
+    @property
+    def benchmark_summary(self) -> Table | None:
+        """The benchmark in brief for the summary, None where this report has no benchmark."""
+        return benchmark_summary(self.tables["benchmark"]) if "benchmark" in self.tables else None
+
+
+#: The figure the report's summary shows beside the benchmark: the thresholds against W/L (paper Fig. 8).
+SUMMARY_FIGURE = "thresholds_vs_width"
+#: The benchmark's columns in the summary: (heading, column of the value; its bar is <column>_error_bar).
+BENCHMARK_SUMMARY = (("FEM dW1/L", "fem_dW1"), ("FEM dW2/L", "fem_dW2"), ("plate dW1/L", "plate_dW1"),
+                     ("plate dW2/L", "plate_dW2"))
+
+
+def benchmark_summary(table: Table) -> Table:
+    """The benchmark table (benchmark_table) in brief: per scene the FEM shell's and the plate's
+    converged dW1/L and dW2/L, each with its error bar (validation.benchmark.with_bar)."""
+    from .benchmark import with_bar
+
+    rows = [{"dL/L": fraction(r["compression_ratio"]), "W/L": fraction(r["width_ratio"])}
+            | {heading: with_bar(finite_float(r.get(key)), finite_float(r.get(f"{key}_error_bar")))
+               for heading, key in BENCHMARK_SUMMARY} for r in table.rows]
+    return Table("benchmark_summary", ["dL/L", "W/L"] + [heading for heading, _ in BENCHMARK_SUMMARY], rows)
 
 
 # ---------------------------------------------------------------------------- reading runs

@@ -137,9 +137,72 @@ class PaperReading:
 
 
 @dataclass(frozen=True)
+class ClaimLine:
+    """One claim in one line (the report's summary): its outcome and the figure that decides it.
+    A single-model claim: its measured |value| against the bound. A cross-model claim: the point
+    that decides its outcome (validation.claims.Agreement.deciding), its difference against the bound
+    and its combined error bar against the claim's error-bar limit, and where the reference stops
+    short of the compared range. claim: a row of validation.claims.evaluate."""
+    claim: dict
+
+    @property
+    def key(self) -> str:
+        return self.claim["claim"]
+
+    @property
+    def outcome(self) -> str:
+        return self.claim.get("outcome", "holds" if self.claim["holds"] else "fails")
+
+    @property
+    def cross_model(self) -> bool:
+        return self.claim.get("error_bar_limit") is not None
+
+    @property
+    def value(self) -> float | None:
+        """The figure set against the bound: the deciding point's difference, or the measured value;
+        None without a measured value (no data)."""
+        if self.claim.get("measured") is None:
+            return None
+        return self.claim.get("deciding_difference") if self.cross_model else self.claim["measured"]
+
+    @property
+    def bound(self) -> float:
+        return self.claim["bound"]
+
+    @property
+    def within(self) -> bool:
+        return self.value is not None and self.value <= self.bound
+
+    @property
+    def error_bar(self) -> float | None:
+        return self.claim.get("deciding_error_bar") if self.value is not None else None
+
+    @property
+    def limit(self) -> float | None:
+        return self.claim.get("error_bar_limit")
+
+    @property
+    def decidable(self) -> bool:
+        """The combined error bar is within the claim's limit (the bars can decide the claim)."""
+        return self.error_bar is not None and self.error_bar <= self.limit
+
+    @property
+    def stops_short(self) -> bool:
+        return bool(self.claim.get("stops_short"))
+
+
+@dataclass(frozen=True)
 class ClaimsVerdict:
     """All claims hold, or which do not (claims: rows of validation.claims.evaluate)."""
     claims: list[dict]
+
+    @property
+    def lines(self) -> list[ClaimLine]:
+        return [ClaimLine(c) for c in self.claims]
+
+    @property
+    def held(self) -> list[dict]:
+        return [c for c in self.claims if c["holds"]]
 
     @property
     def failing(self) -> list[dict]:

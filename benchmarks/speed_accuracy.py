@@ -5,8 +5,9 @@ plate and the FEM shell, on the meshes of their mesh studies (issue 29).
         [--timeout 3600] [--rerun]
 
 Scene (fixed): W/L = 1/6, dL/L = 1/2, the default strip (L/b = 1181, ddg.Strip.from_ratios(1/6,
-0.5)), the default path (docs/guide/run_a_scene.rst): compression in 40 recorded steps, shear in 120 to dW_max, dW1 and dW2
-located, no branch tracing. The entries are exactly the runs of the mesh studies of this scene:
+0.5)), the default path (docs/guide/run_a_scene.rst): compression in 40 recorded steps, shear in
+120 to dW_max, dW1 and dW2 located, no branch tracing. The entries are exactly the runs of the mesh
+studies of this scene:
 
 - plate:8, plate:12, plate:18: the paper's plate on equilateral meshes of 8/12/18 rows of
   triangles across W (data/plate_gold/dL0.5_W0.1667/R<rows>), run by validation.plate_gold.run_mesh

@@ -115,6 +115,53 @@ def test_missing_dask_names_the_extra_in_one_line(tmp_path, capsys, monkeypatch)
     assert not (tmp_path / "out").exists()
 
 
+# ---------------------------------------------------------------------------- the Python API
+def test_run_sweep_is_the_command_from_python_and_returns_its_table(tmp_path, scheduler, monkeypatch):
+    """ddg.sweep.run_sweep: the same grid, the same sweep.csv the command writes, its rows returned;
+    a second call takes every run from the cache without a cluster."""
+    from ddg.sweep import run_sweep
+
+    grid_args = dict(width_ratios=[0.05, 0.1], compression_ratios=[0.5], resolutions=[M],
+                     compression_steps=COMPRESSION_STEPS, shear_steps=SHEAR_STEPS)
+    result = run_sweep(["rod"], out=tmp_path / "api", scheduler=scheduler, figure=False, **grid_args)
+    assert result.complete and result.runs == 2 and not result.incomplete and result.interrupted is None
+    assert result.rows == read_table(tmp_path / "api" / "sweep.csv")
+    assert [r["W_over_L"] for r in result.rows] == [0.05, 0.1]
+    assert result.rows[0]["dW1_over_L"] == pytest.approx(direct(0.05)["dW1_over_L"], rel=1e-12)
+    assert result.files[0] == tmp_path / "api" / "sweep.csv" and not (tmp_path / "api" / "phase_diagram.png").exists()
+    assert main(SMALL_GRID + ["--scheduler", scheduler, "--out", str(tmp_path / "cli"), "--quiet"]) == 0
+    columns = [c for c in COLUMNS if c not in ("wall_time_s", "run_dir")]
+    assert [[r[c] for c in columns] for r in read_table(tmp_path / "cli" / "sweep.csv")] == \
+        [[r[c] for c in columns] for r in result.rows]
+
+    monkeypatch.setattr(C, "connect", no_cluster)
+    again = run_sweep("rod", out=tmp_path / "api", figure=False, **grid_args)   # a string is a list of one
+    assert len(again.outcome.cached) == 2 and not again.outcome.computed and again.outcome.where == ""
+    if importlib.util.find_spec("pandas") is not None:
+        frame = again.to_dataframe()
+        assert list(frame.columns) == list(COLUMNS) and len(frame) == 2
+
+
+@pytest.mark.parametrize("argument, value, named", [
+    ("width_ratios", [0.05, 1.5], "width_ratios = 1.5"), ("compression_ratios", "0.5, nan", "nan"),
+    ("models", ["rod", "spaghetti"], "models 'spaghetti'"), ("resolutions", [3], "3"),
+    ("slendernesses", [5], "5"), ("width_ratios", [0.1] * 51, "width_ratios has 51 values"),
+    ("workers", 0, "0"),
+])
+def test_run_sweep_refuses_bad_input_before_any_work(argument, value, named, tmp_path, monkeypatch):
+    from ddg.geometry.strip import InputError
+    from ddg.sweep import run_sweep
+
+    monkeypatch.setattr(C, "connect", no_cluster)
+    kwargs = dict(models=["rod"], width_ratios=[0.05], compression_ratios=[0.5], resolutions=[M],
+                  out=tmp_path / "out")
+    kwargs[argument] = value
+    with pytest.raises(InputError) as error:
+        run_sweep(**kwargs)
+    assert named in str(error.value) and "\n" not in str(error.value)
+    assert not (tmp_path / "out").exists()
+
+
 # ---------------------------------------------------------------------------- cache and resume
 def test_a_half_written_run_folder_is_not_finished_and_is_run_again(tmp_path):
     """What a killed attempt leaves (summary.json "running", part of path.csv, no spec.json)."""

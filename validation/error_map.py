@@ -13,8 +13,9 @@ value, the spread as error bar).
 
 Rows, one per (model, resolution, scene): the rod at M = 50/100/200 and every other model of the
 rod's family registered in ddg.api.DEFAULT_RESOLUTION at run time (the ribbons) at M = 51/101/201,
-run here through ddg.api.run_candidate (the default path of docs/guide/run_a_scene.rst: 40 compression and 120 shear steps to
-dW_max, thresholds from stability, no branch tracing; nothing written to disk); the plate at each
+run here through ddg.api.run_candidate (the default path of docs/guide/run_a_scene.rst: 40
+compression and 120 shear steps to dW_max, thresholds from stability, no branch tracing; nothing
+written to disk); the plate at each
 mesh of its study (data/plate_gold/<scene>/R*, data/narrow_limit/Lb*/plate_R*), the mid-edge plate
 where data/midedge_gold has it and the FEM at each mesh of its study (data/fem_gold/<scene>/N*x*,
 data/narrow_limit/Lb*/fem_N*), read, not rerun. Per row, for q in dW1/L, dW2/L: |q - reference|

@@ -229,13 +229,17 @@ class PathTable:
     def to_dataframe(self, stage: str | None = None):
         """The rows as a pandas DataFrame (pandas: Debian python3-pandas, or pip install
         'ddg-strips[dataframe]'); ImportError in one line naming it when pandas is missing."""
-        try:
-            import pandas
-        except ImportError:
-            raise ImportError("to_dataframe needs pandas, which is not installed: pip install 'ddg-strips[dataframe]' "
-                              "(or apt install python3-pandas); result.arrays() gives numpy arrays without it") \
-                from None
-        return pandas.DataFrame(self.arrays(stage))
+        return require_pandas("result.arrays() gives numpy arrays").DataFrame(self.arrays(stage))
+
+
+def require_pandas(without: str):
+    """pandas, or ImportError in one line naming the extra and what works `without` it."""
+    try:
+        import pandas
+    except ImportError:
+        raise ImportError("to_dataframe needs pandas, which is not installed: pip install 'ddg-strips[dataframe]' "
+                          f"(or apt install python3-pandas); without it {without}") from None
+    return pandas
 
 
 class StoredRun(PathTable):

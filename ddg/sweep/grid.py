@@ -23,8 +23,8 @@ MODELS = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", "ribbon
 
 #: Modules of this package that schedule runs and present results but take no part in computing
 #: one: editing them keeps every cached run (a new module is hashed until it is listed here).
-ORCHESTRATION = ("sweep/cluster.py", "sweep/command.py", "sweep/cache.py", "sweep/table.py", "sweep/figure.py",
-                 "sweep/worker.py", "advise.py", "protocol/validity.py", "protocol/progress.py",
+ORCHESTRATION = ("sweep/cluster.py", "sweep/command.py", "sweep/run.py", "sweep/cache.py", "sweep/table.py",
+                 "sweep/figure.py", "sweep/worker.py", "advise.py", "protocol/validity.py", "protocol/progress.py",
                  "cli.py", "__main__.py")   # the command line: runs go through ddg.api
 
 #: Most runs one sweep may ask for (a rod path costs ~1 s, a 2000-triangle plate ~30-80 s).

@@ -75,10 +75,13 @@ def _fraction(value: float) -> str:
 
 
 def _with_bar(value, bar) -> str:
-    if value in (None, ""):
-        return "\u2013"
-    text = f"{float(value):.4f}"
-    return text if bar in (None, "") else f"{text} \u00b1 {float(bar):.4f}"
+    """A CSV cell pair as the benchmark writes it (validation.benchmark.with_bar: "0.3511 ± 0.0012")."""
+    from validation.benchmark import with_bar
+
+    def number(cell):
+        return None if cell in (None, "") else float(cell)
+
+    return with_bar(number(value), number(bar))
 
 
 class _TableDirective(Directive):

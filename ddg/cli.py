@@ -173,7 +173,7 @@ def _output_directory(out) -> Path:
     return check_output_directory(out, "--out")
 
 
-#: The files a run folder may hold, in the order the final line lists them (README "Outputs").
+#: The files a run folder may hold, in the order the final line lists them (docs/reference/output_contract.rst).
 RUN_FILES = ("path.csv", "summary.json", "centerline.csv", "branches.csv", "rod_path.csv", "frames/")
 
 

@@ -202,14 +202,14 @@ def read_numeric_rows(path: Path) -> list[dict]:
 
 
 class PathTable:
-    """The recorded rows of a run (path.csv: one row per recorded equilibrium, README "Outputs")
+    """The recorded rows of a run (path.csv: one row per recorded equilibrium, docs/reference/output_contract.rst)
     as numpy arrays or a pandas DataFrame; shared by SimulationResult and StoredRun."""
 
     rows: list[dict]
 
     def column(self, name: str, stage: str | None = None) -> np.ndarray:
         """One column of path.csv as a numpy array, e.g. column("H_mid_over_L", "shear"): every
-        recorded row, or those of `stage` ("compression" or "shear"). Columns (README): stage,
+        recorded row, or those of `stage` ("compression" or "shear"). Columns (the output contract): stage,
         dL_over_L, dW_over_L (dL/L, dW/L), H_mid_over_L (mid-point height / L), F_shear_norm
         (F_y L / (E b^3), App. E), energy (J), lambda_min (lowest eigenvalue, normalised), phase (U,
         US+, US-, S+, S-), then F_axial_norm, stable, newton_iterations, branch_switched,

@@ -1,6 +1,6 @@
 """A run's result: the recorded rows (path.csv), summary.json and the per-row centerlines.
 
-Every model writes the same files with the same keys (the README's output contract);
+Every model writes the same files with the same keys (the output contract, docs/reference/output_contract.rst);
 base_summary lists every key a run's summary.json has before the run starts, and
 finish_summary sets its status, converged flag and message when it ends.
 """
@@ -29,7 +29,7 @@ class SimulationResult(PathTable):
 
     rows: one dict per recorded equilibrium, the columns of path.csv (PathTable.column lists
     them; normalised: dW/L, H_mid/L, F L/(E b^3)); summary: summary.json as a dict (thresholds
-    dW1_over_L, dW2_over_L, status, converged, message, warnings, ... README "Outputs");
+    dW1_over_L, dW2_over_L, status, converged, message, warnings, ... docs/reference/output_contract.rst);
     final_state: the last converged ddg.solve.state.State (SI units: q in m and rad); model: the
     model object (its positions(q), midpoint(q), ...); centerlines: per row the (stations, 3)
     positions of the centreline w = 0 (m); branch_rows: the rows of branches.csv (every branch,

@@ -16,8 +16,8 @@ import ddg
 from ddg.output.io import StoredRun
 from validation.__main__ import main
 from validation.reference import ROOT
-from validation.score import (BENCHMARK_VERSION, H_MID_ERROR_BAR_FLOOR, REQUIRED_COLUMNS, load_benchmark,
-                              read_results, score_results, write_benchmark_files)
+from validation.score import (BENCHMARK_RELEASES, BENCHMARK_VERSION, H_MID_ERROR_BAR_FLOOR, REQUIRED_COLUMNS,
+                              load_benchmark, read_results, score_results, write_benchmark_files)
 
 ERROR_MAP = ROOT / "data" / "error_map" / "error_map.csv"
 HEADER = ("kind",) + REQUIRED_COLUMNS + ("dW_over_L", "H_mid_over_L")
@@ -379,3 +379,14 @@ def test_without_matplotlib_the_figure_is_skipped_with_one_line(scenes, tmp_path
     assert code == 0 and err == "figure skipped: matplotlib is missing (pip install 'ddg-strips[plot]')\n"
     assert sorted(p.name for p in (tmp_path / "score").iterdir()) == ["score.csv", "score.md"]
     assert math.isclose(float(score_rows(tmp_path / "score")[0]["submitted"]), 0.3)
+
+
+def test_the_committed_studies_are_the_benchmark_version_they_are_released_as():
+    """A changed or added study in data/fem_gold changes the digest; it must come with a new release
+    (BENCHMARK_RELEASES), so no scorecard calls changed reference values by an old version."""
+    from validation.score import benchmark_digest
+
+    assert BENCHMARK_RELEASES[BENCHMARK_VERSION] == benchmark_digest(load_benchmark()), (
+        "data/fem_gold changed: add a release to validation.score.BENCHMARK_RELEASES with the new digest and "
+        "say what changed in docs/reference/benchmark.rst")
+    assert len(set(BENCHMARK_RELEASES.values())) == len(BENCHMARK_RELEASES)

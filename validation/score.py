@@ -80,9 +80,16 @@ from .claims import THRESHOLD_BAND
 from .estimates import Estimate, Study, difference_away_from_thresholds, load_study
 from .reference import FEM_GOLD, ROOT
 
-#: The benchmark's release: bump it when its scenes or values change (a new or extended mesh study in
-#: data/fem_gold, a new error-bar rule); benchmark_digest() tells whether the data under it changed.
-BENCHMARK_VERSION = "2026.11-1"
+#: Every release of the benchmark and the digest of the studies it was made from (benchmark_digest):
+#: a new or extended mesh study in data/fem_gold, or a new error-bar rule, is a new release.
+#: tests/test_score.py checks that the committed studies are BENCHMARK_VERSION's, so changed data cannot
+#: keep an old version. What each release changed: docs/reference/benchmark.rst, "Releases".
+BENCHMARK_RELEASES = {
+    "2026.11-1": "e7a809c515e9c367",   # 28 scenes
+    "2026.11-2": "b42ced51e49a96e2",   # dL/L = 1/3, W/L = 1/6 on a fourth mesh (216 x 28)
+}
+#: The benchmark's release: the newest of BENCHMARK_RELEASES.
+BENCHMARK_VERSION = list(BENCHMARK_RELEASES)[-1]
 #: The gold runs' Poisson ratio (summary.json scene.poisson_ratio; ddg.Strip's default).
 BENCHMARK_POISSON_RATIO = 0.0
 #: Relative tolerance on dL/L, W/L and L/b for a submitted row to be a benchmark scene (0.1 %).

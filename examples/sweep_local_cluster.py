@@ -1,10 +1,10 @@
 """A small sweep on a two-worker Dask LocalCluster, read back as a table.
 
 `python -m ddg sweep` runs a grid of scenes as Dask tasks; `ddg.sweep.run_sweep` is the same thing
-from Python (the command calls it), here on a grid of three rod runs: the default scene (W/L = 1/20, dL/L = 1/2) at M = 50, 100 and 200
-nodes, a convergence study. Each run lands in DIR/runs/<key>/, a hash of its inputs and of the
-ddg sources; DIR/sweep.csv has one row per run. Running the sweep again computes nothing: every
-run is found in the cache (no cluster is even started).
+from Python (the command calls it), here on a grid of three rod runs: the default scene (W/L = 1/20,
+dL/L = 1/2) at M = 50, 100 and 200 nodes, a convergence study. Each run lands in DIR/runs/<key>/, a
+hash of its inputs and of the ddg sources; DIR/sweep.csv has one row per run. Running the sweep
+again computes nothing: every run is found in the cache (no cluster is even started).
 
 To use an existing cluster instead, pass its scheduler's address: run_sweep(...,
 scheduler="tcp://host:8786") (workers started with the same checkout and virtualenv).

@@ -275,11 +275,11 @@ def test_issue_32_predictions_hold_on_the_held_out_scenes(tolerance):
 
 #: The two targets not met, each a strict expected failure with its figures.
 UNMET_WITHIN = ("issue 32's target not met: a model is predicted within 0.01 at 1 of the 4 held-out scenes (25 %; "
-                "bound 80 %), the mid-edge plate on 8 rows at dL/L = 0.4 (predicted 0.0052, measured 0.0029), and within "
-                "0.02 at 2 of 4 (50 %), also the mid-edge plate on 10 rows at W/L = 1/8, dL/L = 1/3 (predicted 0.0114) "
-                "since the basis reference dL/L = 1/3, W/L = 1/6 gained a fourth mesh (benchmark 2026.11-2; before it "
-                "1 of 4, predicted 0.0363); elsewhere the best is predicted 0.0320 (W/L = 1/4 at dL/L = 0.3) and "
-                "0.0618 (L/b = 2000)")
+                "bound 80 %), the mid-edge plate on 8 rows at dL/L = 0.4 (predicted 0.0052, measured 0.0029), and "
+                "within 0.02 at 2 of 4 (50 %), also the mid-edge plate on 10 rows at W/L = 1/8, dL/L = 1/3 (predicted "
+                "0.0114) since the basis reference dL/L = 1/3, W/L = 1/6 gained a fourth mesh (benchmark 2026.11-2; "
+                "before it 1 of 4, predicted 0.0363); elsewhere the best is predicted 0.0320 (W/L = 1/4 at dL/L = 0.3) "
+                "and 0.0618 (L/b = 2000)")
 UNMET_WALL = ("issue 32's target not met: the choices predicted within take 175 s (the mid-edge plate on 8 rows at "
               "dL/L = 0.4, its held-out study run at nice 19 beside the shell; 36 s at the default scene in "
               "benchmarks/results/auto_choice.md) and, at 0.02, the mid-edge plate on 10 rows at W/L = 1/8, 104 s "

@@ -87,6 +87,7 @@ from .reference import FEM_GOLD, ROOT
 BENCHMARK_RELEASES = {
     "2026.11-1": "e7a809c515e9c367",   # 28 scenes
     "2026.11-2": "b42ced51e49a96e2",   # dL/L = 1/3, W/L = 1/6 on a fourth mesh (216 x 28)
+    "2026.11-3": "473e7825cf89c444",   # dL/L = 1/3, W/L = 1/3 on a fourth mesh (216 x 54)
 }
 #: The benchmark's release: the newest of BENCHMARK_RELEASES.
 BENCHMARK_VERSION = list(BENCHMARK_RELEASES)[-1]

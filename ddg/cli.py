@@ -113,8 +113,12 @@ def build_parser() -> argparse.ArgumentParser:
     adv.add_argument("--poisson-ratio", type=float, default=0.0,
                      help="nu (default 0, the error map's; another value is refused: the map is at nu = 0)")
     _add_auto_arguments(adv, "")
-    sub.add_parser("warmup", help="compile and cache the numba kernels once (scripts/setup.sh runs it), "
-                                  "so the first run pays no JIT cost")
+    warm = sub.add_parser("warmup", help="compile and cache the numba kernels once (scripts/setup.sh runs it), "
+                                         "so the first run pays no JIT cost")
+    warm.add_argument("parts", nargs="*", metavar="PART",
+                      help="models (rod, plate, plate-midedge, the ribbons) or 'arrays'; default all")
+    warm.add_argument("--jobs", type=int, default=None,
+                      help="worker processes (default: the machine's cores, at most 4)")
     err = sub.add_parser("centerline-error",
                          help="plate centerline approximation error (Eqs. 12-13) against L/W (Fig. 10): CSV and PNG")
     err.add_argument("--width-ratios", default="0.5,0.3333333333333333,0.16666666666666666,0.08333333333333333,0.05",
@@ -521,9 +525,14 @@ def _main(argv=None) -> int:
 
             return render(args)
         if args.command == "warmup":
-            from .warmup import main as warmup
+            from .warmup import PARTS, main as warmup
 
-            return warmup()
+            for part in args.parts:
+                if part not in PARTS:
+                    raise InputError(f"warm-up part {part!r} is not one of {', '.join(PARTS)}")
+            if args.jobs is not None and not 1 <= args.jobs <= 64:
+                raise InputError(f"--jobs = {args.jobs} is outside 1..64")
+            return warmup(args.parts or None, args.jobs)
         return EXIT_BAD_INPUT
     except InputError as exc:
         sys.stderr.write(f"error: {_one_line(exc)}\n")

@@ -1,111 +1,176 @@
-"""Compile and cache every numba kernel once, so that a user's first run pays no JIT cost.
+"""Compile and cache the numba kernels once, so that a user's first run pays no JIT cost.
 
-    python -m ddg warmup
+    python -m ddg warmup [--jobs N] [PART ...]
 
-runs each compiled kernel on a tiny model with every argument type the solvers use (energy only,
-gradient, gradient and Hessian; rod, ribbons, plate; the array interfaces used in analysis). numba
-stores the machine code next to the modules (`cache=True`, in `__pycache__`); later processes
-load it (~0.2 s for all kernels) instead of compiling (838 s with an empty cache on a 2-core machine
-beside other runs, measured in the CI of 7337dec; 456 s idle before the wide ribbons' terms joined
-the compiled solvers). scripts/setup.sh calls it.
+A part is a model of the API (`rod`, `plate`, `plate-midedge`, the ribbons: each model's
+kernels, evaluated with every argument type its solvers use, and for the rod family the compiled
+Newton load step and pseudo-arclength corrector) or `arrays` (the array interfaces of analysis and
+the banded linear algebra every model uses). No part: all of them, spread over N worker
+processes (default: the machine's cores, at most 4). numba stores the machine code next to the
+modules (`cache=True`, in `__pycache__`); later processes load it instead of compiling. A model
+left out here compiles its kernels in the user's first run, and a kernel compiles on first use
+anyway: the warm-up only moves that cost to install time (scripts/setup.sh calls it).
+benchmarks/compile_time.py measures each part and kernel from an empty cache.
 """
 from __future__ import annotations
 
+import os
+import sys
 import time
 
 import numpy as np
 
+#: Rod-family parts share one compiled energy (ddg.models.rod_assembly.rod_energy) per kind of
+#: width terms; the plates share nothing with them.
+ROD_FAMILY = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section", "ribbon-wunderlich")
+PLATES = ("plate", "plate-midedge")
+PARTS = ROD_FAMILY + PLATES + ("arrays",)
 
-def compile_kernels() -> dict:
-    """Run every kernel once; returns the seconds spent per group (compiling where not cached)."""
+
+def _strip():
+    from .geometry.strip import Strip
+
+    return Strip.from_ratios(1 / 6, 0.5)
+
+
+def _evaluate_every_way(model, rng) -> None:
+    q = model.reset()
+    q = q + 1e-3 * model.strip.length * rng.standard_normal(q.shape)
+    model.commit(q)
+    for gradient, hessian in ((False, False), (True, False), (True, True)):
+        model.evaluate(q, gradient=gradient, hessian=hessian)
+
+
+def _rod_family(name: str, rng) -> None:
+    """The model's compiled energy, then the compiled Newton load step and corrector on it."""
+    from .models.ribbon import RibbonModel
+    from .models.rod import RodModel
+    from .models.wide_ribbons import CrossSectionRibbon, SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon
+    from .solve.arclength import ArclengthTracer
+    from .solve.newton import NewtonOptions, newton
+    from .solve.state import State
+
+    strip = _strip()
+    build = {"rod": lambda: RodModel(strip, 9), "ribbon": lambda: RibbonModel(strip, 9),
+             "ribbon-sano-wada": lambda: SanoWadaRibbon(strip, 9), "ribbon-trapeze": lambda: TrapezeRibbon(strip, 9),
+             "ribbon-cross-section": lambda: CrossSectionRibbon(strip, 9),
+             "ribbon-wunderlich": lambda: WunderlichRibbon(strip, 9, zeta=0.01 * strip.length)}
+    model = build[name]()
+    _evaluate_every_way(model, rng)
+    model = build[name]()
+    compression = 0.3 * strip.length
+    q = model.apply_clamps(model.buckled_guess(compression), compression, 0.0)
+    result = newton(model, q, NewtonOptions())
+    start = State(result.q, result.evaluation, compression, 0.0, True)
+    ArclengthTracer(model, NewtonOptions()).trace(start, max_points=1)
+
+
+def _plate(name: str, rng) -> None:
     from .energies.hinge_bending import hinge_bending_energy, triangle_normals
+    from .models.midedge_plate import MEMBRANES, MidedgePlateModel
+    from .models.plate import PlateModel
+
+    strip = _strip()
+    if name == "plate-midedge":
+        for membrane in MEMBRANES:
+            _evaluate_every_way(MidedgePlateModel(strip, 40, membrane=membrane), rng)
+        return
+    plate = PlateModel(strip, 40)
+    _evaluate_every_way(plate, rng)
+    xp = plate.reset().reshape(-1, 3)
+    triangle_normals(xp, plate.mesh.triangles)
+    for gradient, hessian in ((False, False), (True, False), (True, True)):
+        hinge_bending_energy(xp, plate.mesh.triangles, plate.mesh.hinge_triangles, plate.hinge_stiffness,
+                             gradient=gradient, hessian=hessian)
+
+
+def _arrays(rng) -> None:
+    """The array interfaces of analysis and the banded linear algebra of every model."""
     from .energies.rod_curvature import material_curvatures, strain_derivatives
     from .energies.stretch import stretching_energy
     from .geometry.frames import parallel_transport, reference_twist
-    from .geometry.strip import Strip
-    from .models.plate import PlateModel
-    from .models.ribbon import RibbonModel
-    from .models.rod import RodModel
-    from .models.midedge_plate import MEMBRANES, MidedgePlateModel
-    from .models.wide_ribbons import CrossSectionRibbon, SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon
     from .solve.banded import SymmetricBanded
     from .solve.lanczos import lowest_eigenvalue
 
-    strip = Strip.from_ratios(1 / 6, 0.5)
-    rng = np.random.default_rng(0)
-    timings = {}
-
-    def timed(name, work):
-        start = time.perf_counter()
-        work()
-        timings[name] = round(time.perf_counter() - start, 3)
-
-    def models():
-        # every model the API offers (ddg.api.DEFAULT_RESOLUTION): a model left out here compiles its
-        # kernels in the user's first run (the cross-section ribbon's took 80 s and 2.2 GB, measured)
-        for model in (RodModel(strip, 9), RibbonModel(strip, 9), SanoWadaRibbon(strip, 9), TrapezeRibbon(strip, 9),
-                      CrossSectionRibbon(strip, 9), WunderlichRibbon(strip, 9, zeta=0.01 * strip.length),
-                      PlateModel(strip, 40), *(MidedgePlateModel(strip, 40, membrane=m) for m in MEMBRANES)):
-            q = model.reset()
-            q = q + 1e-3 * strip.length * rng.standard_normal(q.shape)
-            model.commit(q)
-            for gradient, hessian in ((False, False), (True, False), (True, True)):
-                model.evaluate(q, gradient=gradient, hessian=hessian)
-
-    def arrays():
-        x = np.cumsum(rng.standard_normal((6, 3)), axis=0)
-        t = x[1:] - x[:-1]
-        t /= np.linalg.norm(t, axis=1)[:, None]
-        d1 = np.cross(t, rng.standard_normal(t.shape))
-        d1 /= np.linalg.norm(d1, axis=1)[:, None]
-        m2 = np.cross(t, d1)
-        parallel_transport(d1, t, t[::-1].copy())
-        reference_twist(d1, t)
-        reference_twist(d1, t, np.zeros(len(t) - 1))
-        material_curvatures(x, d1, m2)
-        strain_derivatives(x, d1, m2)
-        for gradient, hessian in ((False, False), (True, False), (True, True)):
-            stretching_energy(t, np.ones(len(t)), 1.0, gradient=gradient, hessian=hessian)
-        plate = PlateModel(strip, 40)
-        xp = plate.reset().reshape(-1, 3)
-        triangle_normals(xp, plate.mesh.triangles)
-        # linear algebra: Lanczos on the Cholesky factor, LDL^T of an indefinite band (both paths)
-        for bandwidth in (3, 40):
-            band = np.zeros((bandwidth + 1, 60))
-            band[0] = np.linspace(-1.0, 3.0, 60)
-            band[1, :-1] = 0.1
-            SymmetricBanded(band).solve(np.ones(60))
-            band[0] += 2.0
-            spd = SymmetricBanded(band)
-            if spd.cholesky():
-                lowest_eigenvalue(spd.cholesky_factor, np.ones(60))
-        for gradient, hessian in ((False, False), (True, False), (True, True)):
-            hinge_bending_energy(xp, plate.mesh.triangles, plate.mesh.hinge_triangles, plate.hinge_stiffness,
-                                 gradient=gradient, hessian=hessian)
-
-    def solvers():
-        # the compiled Newton load step and pseudo-arclength corrector of the rod family
-        # (ddg.solve.compiled_newton): one specialisation serves the rod and the Sadowsky ribbons
-        from .solve.arclength import ArclengthTracer
-        from .solve.newton import NewtonOptions, newton
-        from .solve.state import State
-
-        model = RodModel(strip, 9)
-        compression = 0.3 * strip.length
-        q = model.apply_clamps(model.buckled_guess(compression), compression, 0.0)
-        result = newton(model, q, NewtonOptions())
-        start = State(result.q, result.evaluation, compression, 0.0, True)
-        ArclengthTracer(model, NewtonOptions()).trace(start, max_points=1)
-
-    timed("models", models)
-    timed("compiled solvers", solvers)
-    timed("array interfaces", arrays)
-    return timings
+    x = np.cumsum(rng.standard_normal((6, 3)), axis=0)
+    t = x[1:] - x[:-1]
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    d1 = np.cross(t, rng.standard_normal(t.shape))
+    d1 /= np.linalg.norm(d1, axis=1)[:, None]
+    m2 = np.cross(t, d1)
+    parallel_transport(d1, t, t[::-1].copy())
+    reference_twist(d1, t)
+    reference_twist(d1, t, np.zeros(len(t) - 1))
+    material_curvatures(x, d1, m2)
+    strain_derivatives(x, d1, m2)
+    for gradient, hessian in ((False, False), (True, False), (True, True)):
+        stretching_energy(t, np.ones(len(t)), 1.0, gradient=gradient, hessian=hessian)
+    # Lanczos on the Cholesky factor, LDL^T of an indefinite band (both paths)
+    for bandwidth in (3, 40):
+        band = np.zeros((bandwidth + 1, 60))
+        band[0] = np.linspace(-1.0, 3.0, 60)
+        band[1, :-1] = 0.1
+        SymmetricBanded(band).solve(np.ones(60))
+        band[0] += 2.0
+        spd = SymmetricBanded(band)
+        if spd.cholesky():
+            lowest_eigenvalue(spd.cholesky_factor, np.ones(60))
 
 
-def main() -> int:
+def compile_part(part: str) -> float:
+    """Compile (or load) one part's kernels; returns its seconds."""
+    if part not in PARTS:
+        from .geometry.strip import InputError
+
+        raise InputError(f"warm-up part {part!r} is not one of {', '.join(PARTS)}")
     start = time.perf_counter()
-    timings = compile_kernels()
-    parts = ", ".join(f"{k} {v:.1f} s" for k, v in timings.items())
-    print(f"ddg kernels compiled and cached in {time.perf_counter() - start:.1f} s ({parts})")
+    rng = np.random.default_rng(0)
+    if part in ROD_FAMILY:
+        _rod_family(part, rng)
+    elif part in PLATES:
+        _plate(part, rng)
+    else:
+        _arrays(rng)
+    return round(time.perf_counter() - start, 3)
+
+
+def compile_kernels(parts=None) -> dict:
+    """Compile the parts (default all) in this process, one after the other; seconds per part."""
+    return {part: compile_part(part) for part in (PARTS if parts is None else parts)}
+
+
+def _worker(part: str) -> tuple[str, float]:
+    return part, compile_part(part)
+
+
+def compile_in_parallel(parts=None, jobs: int | None = None) -> dict:
+    """compile_kernels over `jobs` worker processes (spawned: each has its own numba). The parts
+    that share kernels go to one worker in order (the rod family's compiled energy and solvers are
+    compiled once by the first rod-family part, then loaded from the cache by the others)."""
+    parts = list(PARTS if parts is None else parts)
+    jobs = max(1, min(jobs or min(os.cpu_count() or 1, 4), len(parts)))
+    if jobs == 1:
+        return compile_kernels(parts)
+    import concurrent.futures as cf
+    import multiprocessing as mp
+
+    family = [p for p in parts if p in ROD_FAMILY]
+    queues = [family] if family else []
+    queues += [[p] for p in parts if p not in ROD_FAMILY]
+    timings = {}
+    with cf.ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:
+        for done in pool.map(compile_kernels, queues):
+            timings.update(done)
+    return {p: timings[p] for p in parts}
+
+
+def main(parts=None, jobs: int | None = None) -> int:
+    start = time.perf_counter()
+    timings = compile_in_parallel(parts, jobs)
+    listed = ", ".join(f"{k} {v:.1f} s" for k, v in timings.items())
+    print(f"ddg kernels compiled and cached in {time.perf_counter() - start:.1f} s ({listed})")
     return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:] or None))

@@ -58,7 +58,7 @@ def test_quartic_term_partials_match_finite_differences():
     rng = np.random.default_rng(4)
     kn = np.r_[rng.uniform(-0.3, 0.3, 6), 1e-3, -2e-3]
     tau = rng.uniform(-0.2, 0.2, kn.size)
-    r = 0.02
+    r = np.full(kn.size, 0.02)   # the regularisation dl / zeta per stencil
     q, q_k, q_t, q_kk, q_kt, q_tt = quartic_twist_term(kn, tau, r)
     assert q == pytest.approx(tau**4 / (kn**2 + r**2), rel=1e-14)
     eps = 1e-7

@@ -15,13 +15,16 @@ from .rod_curvature import KAPPA_G, KAPPA_N
 @njit(cache=True)
 def bending_density(kappa_n, kappa_g, voronoi_lengths, bending_stiffness, geodesic_bending_stiffness):
     """E_b per stencil (n,), its partials in (kappa_n, kappa_g, tau) (n, 3) and second partials (n, 3, 3)."""
-    a = bending_stiffness / voronoi_lengths
-    c = geodesic_bending_stiffness / voronoi_lengths
-    energy = 0.5 * (a * kappa_n**2 + c * kappa_g**2)
-    first = np.zeros((len(energy), 3))
-    first[:, KAPPA_N] = a * kappa_n
-    first[:, KAPPA_G] = c * kappa_g
-    second = np.zeros((len(energy), 3, 3))
-    second[:, KAPPA_N, KAPPA_N] = a
-    second[:, KAPPA_G, KAPPA_G] = c
+    n = kappa_n.shape[0]
+    energy = np.empty(n)
+    first = np.zeros((n, 3))
+    second = np.zeros((n, 3, 3))
+    for i in range(n):
+        a = bending_stiffness / voronoi_lengths[i]
+        c = geodesic_bending_stiffness / voronoi_lengths[i]
+        energy[i] = 0.5 * (a * kappa_n[i] * kappa_n[i] + c * kappa_g[i] * kappa_g[i])
+        first[i, KAPPA_N] = a * kappa_n[i]
+        first[i, KAPPA_G] = c * kappa_g[i]
+        second[i, KAPPA_N, KAPPA_N] = a
+        second[i, KAPPA_G, KAPPA_G] = c
     return energy, first, second

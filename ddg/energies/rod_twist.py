@@ -15,16 +15,22 @@ from .rod_curvature import TAU
 @njit(cache=True)
 def discrete_twist(theta: np.ndarray, reference_twist: np.ndarray) -> np.ndarray:
     """tau at the interior nodes (Eq. 5) from the M - 1 twist angles and the M - 2 reference twists."""
-    return theta[1:] - theta[:-1] + reference_twist
+    tau = np.empty(reference_twist.shape[0])
+    for i in range(tau.shape[0]):
+        tau[i] = theta[i + 1] - theta[i] + reference_twist[i]
+    return tau
 
 
 @njit(cache=True)
 def twisting_density(tau, voronoi_lengths, twisting_stiffness):
     """E_t per stencil (n,), its partials in (kappa_n, kappa_g, tau) (n, 3) and second partials (n, 3, 3)."""
-    k = twisting_stiffness / voronoi_lengths
-    energy = 0.5 * k * tau**2
-    first = np.zeros((len(energy), 3))
-    first[:, TAU] = k * tau
-    second = np.zeros((len(energy), 3, 3))
-    second[:, TAU, TAU] = k
+    n = tau.shape[0]
+    energy = np.empty(n)
+    first = np.zeros((n, 3))
+    second = np.zeros((n, 3, 3))
+    for i in range(n):
+        k = twisting_stiffness / voronoi_lengths[i]
+        energy[i] = 0.5 * k * tau[i] * tau[i]
+        first[i, TAU] = k * tau[i]
+        second[i, TAU, TAU] = k
     return energy, first, second

@@ -45,20 +45,27 @@ def check_zeta(zeta) -> float:
 
 
 @njit(cache=True)
-def quartic_twist_term(kappa_n, tau, regularisation):
-    """Q = tau^4 / (kn^2 + r^2) and its first and second partial derivatives in (kn, tau).
-
-    Returns Q, Q_k, Q_t, Q_kk, Q_kt, Q_tt, arrays over stencils (r = dl / zeta, Eq. A.5)."""
-    d = kappa_n**2 + regularisation**2
-    t2 = tau**2
+def quartic(kappa_n, tau, regularisation):
+    """Q = tau^4 / (kn^2 + r^2) and its first and second partial derivatives in (kn, tau) at one
+    stencil: Q, Q_k, Q_t, Q_kk, Q_kt, Q_tt (r = dl / zeta, Eq. A.5)."""
+    r2 = regularisation * regularisation
+    d = kappa_n * kappa_n + r2
+    t2 = tau * tau
     t4 = t2 * t2
-    q = t4 / d
-    q_k = -2.0 * kappa_n * t4 / d**2
-    q_t = 4.0 * tau * t2 / d
-    q_kk = t4 * (6.0 * kappa_n**2 - 2.0 * regularisation**2) / d**3
-    q_kt = -8.0 * kappa_n * tau * t2 / d**2
-    q_tt = 12.0 * t2 / d
-    return q, q_k, q_t, q_kk, q_kt, q_tt
+    return (t4 / d, -2.0 * kappa_n * t4 / (d * d), 4.0 * tau * t2 / d,
+            t4 * (6.0 * kappa_n * kappa_n - 2.0 * r2) / (d * d * d), -8.0 * kappa_n * tau * t2 / (d * d), 12.0 * t2 / d)
+
+
+@njit(cache=True)
+def quartic_twist_term(kappa_n, tau, regularisation):
+    """`quartic` over stencils: arrays Q, Q_k, Q_t, Q_kk, Q_kt, Q_tt (n,) of arrays kappa_n, tau and
+    the regularisation r (n,)."""
+    n = kappa_n.shape[0]
+    out = np.empty((6, n))
+    for i in range(n):
+        q, q_k, q_t, q_kk, q_kt, q_tt = quartic(kappa_n[i], tau[i], regularisation[i])
+        out[0, i], out[1, i], out[2, i], out[3, i], out[4, i], out[5, i] = q, q_k, q_t, q_kk, q_kt, q_tt
+    return out[0], out[1], out[2], out[3], out[4], out[5]
 
 
 def sadowsky_density(kappa_n, tau, voronoi_lengths, bending_stiffness, zeta):
@@ -72,15 +79,17 @@ def sadowsky_density(kappa_n, tau, voronoi_lengths, bending_stiffness, zeta):
 @njit(cache=True)
 def sadowsky_terms(kappa_n, tau, voronoi_lengths, bending_stiffness, zeta):
     """sadowsky_density for a zeta already checked (the compiled assembly calls it)."""
-    a = bending_stiffness / voronoi_lengths
-    q, q_k, q_t, q_kk, q_kt, q_tt = quartic_twist_term(kappa_n, tau, voronoi_lengths / zeta)
-    energy = 0.5 * a * q
-    first = np.zeros((len(energy), 3))
-    first[:, KAPPA_N] = 0.5 * a * q_k
-    first[:, TAU] = 0.5 * a * q_t
-    second = np.zeros((len(energy), 3, 3))
-    second[:, KAPPA_N, KAPPA_N] = 0.5 * a * q_kk
-    second[:, KAPPA_N, TAU] = 0.5 * a * q_kt
-    second[:, TAU, KAPPA_N] = 0.5 * a * q_kt
-    second[:, TAU, TAU] = 0.5 * a * q_tt
+    n = kappa_n.shape[0]
+    energy = np.empty(n)
+    first = np.zeros((n, 3))
+    second = np.zeros((n, 3, 3))
+    for i in range(n):
+        half_a = 0.5 * bending_stiffness / voronoi_lengths[i]
+        q, q_k, q_t, q_kk, q_kt, q_tt = quartic(kappa_n[i], tau[i], voronoi_lengths[i] / zeta)
+        energy[i] = half_a * q
+        first[i, KAPPA_N] = half_a * q_k
+        first[i, TAU] = half_a * q_t
+        second[i, KAPPA_N, KAPPA_N] = half_a * q_kk
+        second[i, KAPPA_N, TAU] = second[i, TAU, KAPPA_N] = half_a * q_kt
+        second[i, TAU, TAU] = half_a * q_tt
     return energy, first, second

@@ -43,6 +43,7 @@ from ..energies.stretch import add_edge_terms
 from ..energies.trapeze import trapeze_density
 from ..energies.wunderlich import wunderlich_pair_density
 from ..geometry.frames import rod_frames
+from ..solve.specialise import specialise
 
 #: The parts rod_energy returns, in its order (zero where the model has no such term).
 PARTS = ("stretching", "bending", "twisting", "sadowsky", "trapeze", "wunderlich", "cross_section",
@@ -173,11 +174,15 @@ def _cross_section(q, x, kappa_n, kappa_g, tau, first, second, rest_lengths, vor
         add_pair_cross_terms(gradients, ps[:, 0:1, 1:2].copy(), np.array([3]), node_stride, n_dof, band)
 
 
-@njit(cache=True)
-def rod_energy(q, state, args, want_gradient, want_hessian, grad, band):
+#: The kind of width terms a specialisation of the energy adds (bound per specialisation by
+#: ddg.solve.specialise: numba compiles only the branch it selects).
+KIND = ROD
+
+
+def _rod_energy(q, state, args, want_gradient, want_hessian, grad, band):
     old_t, old_d1, old_m_ref = state
     node_stride, edge_nodes, rest_lengths, stretch_k, voronoi, ei2, ei1, gj, zeta, width = args
-    kind, reals, vectors, matrices, indices, table = width
+    _, reals, vectors, matrices, indices, table = width
     nodes = old_t.shape[0] + 1
     n_dof = q.shape[0]
     x = np.empty((nodes, 3))
@@ -206,15 +211,32 @@ def rod_energy(q, state, args, want_gradient, want_hessian, grad, band):
                               want_gradient, want_hessian)
     parts[1] = e_b.sum()
     parts[2] = e_t.sum()
-    if kind == TRAPEZE:
+    if KIND == TRAPEZE:
         _trapeze(x, tau, first, second, rest_lengths, voronoi, reals, node_stride, n_dof, want_gradient,
                  want_hessian, grad, band, m1, m2, parts)
-    elif kind == WUNDERLICH:
+    elif KIND == WUNDERLICH:
         _wunderlich(x, kappa_n, tau, first, second, rest_lengths, voronoi, ei2, gj, reals, vectors, node_stride,
                     n_dof, want_gradient, want_hessian, grad, band, m1, m2, parts)
-    elif kind == CROSS_SECTION:
+    elif KIND == CROSS_SECTION:
         _cross_section(q, x, kappa_n, kappa_g, tau, first, second, rest_lengths, voronoi, reals, vectors, matrices,
                        indices, table, node_stride, n_dof, want_gradient, want_hessian, grad, band, m1, m2, parts)
     elif want_gradient:
         add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, want_hessian)
     return parts, (t, d1, m_ref)
+
+
+#: The compiled energy per kind of width terms: one implementation (_rod_energy), compiled apart for
+#: each kind, so that a model compiles its own terms only.
+KIND_NAMES = {ROD: "rod", TRAPEZE: "trapeze", WUNDERLICH: "wunderlich", CROSS_SECTION: "cross_section"}
+ENERGIES = {kind: specialise(_rod_energy, name, KIND=kind) for kind, name in KIND_NAMES.items()}
+
+
+def kind_of(args) -> int:
+    """The kind of width terms of a model's constants (RodModel.assembly_args)."""
+    return args[-1][0]
+
+
+def rod_energy(q, state, args, want_gradient, want_hessian, grad, band):
+    """The energy by part and the frames of q, its gradient added to grad and (want_hessian) its
+    Hessian to the flattened lower band, by the compiled energy of args' kind (see the module)."""
+    return ENERGIES[kind_of(args)](q, state, args, want_gradient, want_hessian, grad, band)

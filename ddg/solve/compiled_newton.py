@@ -1,7 +1,8 @@
 """Newton's method for a load step, and the pseudo-arclength corrector, in one compiled call (numba)
-for the models assembled by the rod's compiled energy (the rod and the Sadowsky ribbons:
-ddg.models.rod_assembly.rod_energy, called directly: numba does not cache a compiled function that
-takes another as an argument, it recompiled these loops for 7.8 s in every process, measured).
+for the models assembled by the rod family's compiled energy (ddg.models.rod_assembly.ENERGIES,
+one per kind of width terms). The loops call the energy directly, bound per kind when they are
+compiled (ddg.solve.specialise: numba does not cache a compiled function that takes another as an
+argument), so each model compiles the loops with its own energy only.
 
 The algorithm is ddg.solve.newton's plain Newton (minimize=False) step for step: the same
 residual and correction measures, the banded Cholesky where the free Hessian is positive
@@ -13,7 +14,7 @@ benchmark benchmarks/rod_path.py). ddg.solve.newton.newton calls it where the mo
 compiled energy (`assembly_args`) and falls back to its own loop otherwise; tests/
 test_compiled_newton.py checks that both take the same iterations to the same states.
 
-`args` are the model's constants for rod_energy (RodModel.assembly_args), `state` the committed
+`args` are the model's constants for the energy (RodModel.assembly_args), `state` the committed
 frames it transports trial states' frames from.
 """
 from __future__ import annotations
@@ -26,8 +27,9 @@ from numba import njit
 from .band_ldlt import BLOCKED_FROM, CHUNK, LEAF, PANEL, ldlt_transposed, solve_transposed_1
 from .band_scatter import band_matvec
 from .banded import SymmetricBanded
-from ..models.rod_assembly import rod_energy
+from ..models.rod_assembly import ENERGIES, KIND_NAMES, ROD, kind_of
 from .lapack import band_cholesky, band_cholesky_solve, band_lu_solve
+from .specialise import specialise
 
 #: Outcomes (NewtonResult.message is written from them in ddg.solve.newton).
 (CONVERGED, ROUNDOFF, NON_FINITE, STALLED, NOT_CONTRACTING, LINE_SEARCH_FAILED, NO_PROGRESS, NO_CONVERGENCE,
@@ -66,7 +68,9 @@ def _solve_indefinite(t, rhs):
     f = t.copy()
     first_tiny = -1
     if m:
-        _, first_tiny, _ = ldlt_transposed(f, tolerance, PANEL, LEAF, CHUNK, BLOCKED_FROM)
+        # the block sizes as runtime ints: numba compiles a separate specialisation for literal arguments
+        sizes = np.array((PANEL, LEAF, CHUNK, BLOCKED_FROM))
+        _, first_tiny, _ = ldlt_transposed(f, tolerance, sizes[0], sizes[1], sizes[2], sizes[3])
     x = np.empty_like(rhs)
     if first_tiny < 0:
         band = np.ascontiguousarray(t.T)
@@ -133,8 +137,7 @@ def _total(parts):
     return total
 
 
-@njit(cache=True)
-def newton_load_step(args, q, state, energy0, parts0, grad0, band0, start, stop, rscale, lscale,
+def _newton_load_step(args, q, state, energy0, parts0, grad0, band0, start, stop, rscale, lscale,
                      residual_tol, step_tol, noise, max_iterations, max_line_search, give_up_after, give_up_ratio,
                      contraction_limit):
     """Plain Newton from q (clamped DOFs set) with its evaluation (energy0, parts0, grad0, band0;
@@ -147,6 +150,9 @@ def newton_load_step(args, q, state, energy0, parts0, grad0, band0, start, stop,
     contraction ratio and the count of consecutive tiny corrections."""
     n = q.shape[0]
     q = q.copy()
+    # a runtime True: numba types a constant argument as Literal[bool] and would compile a second
+    # specialisation of rod_energy (the whole compiled energy again) for it
+    everything = n > 0
     e, parts, grad, band = energy0, parts0, grad0, band0
     rs, ls = rscale[start:stop], lscale[start:stop]
     pd = False
@@ -209,7 +215,7 @@ def newton_load_step(args, q, state, energy0, parts0, grad0, band0, start, stop,
             want_gradient = full or not use_energy
             g_try = np.zeros(n) if want_gradient else np.empty(0)
             b_try = np.zeros(band.shape[0]) if full else np.empty(0)
-            p_try, s_try = rod_energy(q_try, state, args, want_gradient, full, g_try, b_try)
+            p_try, s_try = energy(q_try, state, args, want_gradient, full, g_try, b_try)
             e_try = _total(p_try)
             if math.isfinite(e_try) and (not want_gradient or _all_finite(g_try)):
                 if use_energy:
@@ -221,7 +227,7 @@ def newton_load_step(args, q, state, energy0, parts0, grad0, band0, start, stop,
                     if not full:
                         g_try = np.zeros(n)
                         b_try = np.zeros(band.shape[0])
-                        p_try, s_try = rod_energy(q_try, state, args, True, True, g_try, b_try)
+                        p_try, s_try = energy(q_try, state, args, everything, everything, g_try, b_try)
                         e_try = _total(p_try)
                     break
             alpha *= 0.5
@@ -251,8 +257,7 @@ def _inner(weight2, a_q, a_w, b_q, b_w, length):
     return np.sum(weight2 * a_q * b_q) + a_w * b_w / length**2
 
 
-@njit(cache=True)
-def arclength_correct(args, q, state, shear, band_size, clamp_base, clamp_rate, constrained, anchor_q,
+def _arclength_correct(args, q, state, shear, band_size, clamp_base, clamp_rate, constrained, anchor_q,
                       anchor_shear, t_q, t_w, ds, weight2, length, start, stop, rscale, lscale, residual_tol,
                       step_tol, noise, max_iterations):
     """ddg.solve.arclength.ArclengthTracer._correct in one call: bordered Newton from the predicted
@@ -270,9 +275,10 @@ def arclength_correct(args, q, state, shear, band_size, clamp_base, clamp_rate, 
         rate[constrained[k]] = clamp_rate[k]
     grad = np.zeros(n)
     band = np.zeros(band_size)
+    everything = n > 0   # a runtime True (see newton_load_step)
     # the predictor's frames are not committed: the first correction is transported from the
     # anchor's, as in the Python corrector (transport in time depends on the path it takes)
-    parts, frames = rod_energy(q, state, args, True, True, grad, band)
+    parts, frames = energy(q, state, args, everything, everything, grad, band)
     first, correction = -1.0, np.inf
     rs, ls = rscale[start:stop], lscale[start:stop]
     m = stop - start
@@ -313,6 +319,23 @@ def arclength_correct(args, q, state, shear, band_size, clamp_base, clamp_rate, 
             q[constrained[k]] = clamp_base[k] + shear * clamp_rate[k]
         grad = np.zeros(n)
         band = np.zeros(band_size)
-        parts, frames = rod_energy(q, state, args, True, True, grad, band)
+        parts, frames = energy(q, state, args, everything, everything, grad, band)
         state = frames
     return False, q, shear, parts, grad, band, frames, pd, factor, max_iterations
+
+
+#: The compiled energy the loops call, bound per kind of width terms (ddg.solve.specialise): each
+#: model compiles the loops with its own energy only.
+energy = ENERGIES[ROD]
+_NEWTON = {kind: specialise(_newton_load_step, name, energy=ENERGIES[kind]) for kind, name in KIND_NAMES.items()}
+_ARCLENGTH = {kind: specialise(_arclength_correct, name, energy=ENERGIES[kind]) for kind, name in KIND_NAMES.items()}
+
+
+def newton_load_step(args, *rest):
+    """_newton_load_step compiled with the energy of args' kind (the model's constants)."""
+    return _NEWTON[kind_of(args)](args, *rest)
+
+
+def arclength_correct(args, *rest):
+    """_arclength_correct compiled with the energy of args' kind (the model's constants)."""
+    return _ARCLENGTH[kind_of(args)](args, *rest)

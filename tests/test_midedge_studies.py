@@ -32,6 +32,17 @@ COARSE_DW1, MIDDLE_DW1, MIDDLE_DW2, LOWEST_ORDER = 0.008, 0.003, 0.005, 1.5
 #: An observed order above 4 is no order (the asymptotic window of fem_reference.convergence).
 HIGHEST_ORDER = 4.0
 
+
+def _threshold_rule():
+    from validation.claims import CLAIMS
+
+    return CLAIMS["plate_vs_fem_narrow_thresholds"]
+
+
+#: How the report judges a threshold's agreement with the shell (bound 0.02 L, decided where the
+#: combined error bar is at most 0.02 L): assert_agreement_where_decided.
+THRESHOLD_RULE = _threshold_rule()
+
 #: Scenes whose mid-edge study has not been run yet (issue 29 item 3 in progress; resumable:
 #: `python -m validation.plate_gold --model plate-midedge --out data/midedge_gold --only NAME`).
 NOT_YET_RUN: list[str] = []  # whose study is not complete on its three meshes
@@ -85,18 +96,44 @@ def _study(model, c, w):
     return study
 
 
+def assert_agreement_where_decided(midedge, fem, quantity):
+    """Issue 29's rule (|difference| <= the combined error bar) where the error bars can decide, as
+    the report's threshold claims judge (validation.claims.Claim.outcome_at with the bound and
+    error-bar limit of plate_vs_fem_narrow_thresholds, 0.02 L each): a combined error bar above
+    the limit cannot tell agreement from disagreement, so the entry is undecided and skipped (with
+    its figures), not counted as agreeing, unless the difference exceeds the bound even beyond the
+    combined error bar, which fails it. tests/test_readme.py counts the decided entries of
+    data/benchmark/benchmark.csv by the same rule."""
+    from validation.claims import threshold_agreement
+
+    agreement = threshold_agreement(midedge, fem, quantity)
+    assert agreement is not None, (quantity, midedge.threshold(quantity), fem.threshold(quantity))
+    difference, combined = agreement.difference, agreement.combined_error_bar
+    outcome = THRESHOLD_RULE.outcome_at(difference, combined)
+    assert outcome != "fails", (agreement, outcome)
+    if combined > THRESHOLD_RULE.error_bar_limit:
+        pytest.skip(f"undecided: {agreement.where}: |difference| {difference:.4f} L, combined error bar "
+                    f"{combined:.4f} L > {THRESHOLD_RULE.error_bar_limit:g} L (validation.claims)")
+    assert difference <= combined, agreement
+
+
 @pytest.mark.parametrize("quantity", ["dW1", "dW2"])
 @pytest.mark.parametrize("scene", SCENES, ids=[_id(*s) for s in SCENES])
 def test_midedge_and_fem_thresholds_agree_within_their_combined_error_bars(request, scene, quantity):
+    """Where the error bars decide (assert_agreement_where_decided); measured on the committed
+    studies: 15 of the 20 entries decided, all within their combined error bars (|diff|/combined at
+    most 0.74); undecided the dW1 at dL/L = 1/2, W/L = 1/6 (combined 0.023 L) and the dW2 at
+    dL/L = 1/2, W/L = 1/6, 1/3, 1/2 and dL/L = 1/4, W/L = 1/2 (0.14-0.23 L)."""
     _xfail_if_missed(request, f"agree {_id(*scene)} {quantity}")
     assert len(_study("plate-midedge", *scene).meshes) >= 3, "a study rests on three meshes"
-    fem, midedge = (getattr(_study(m, *scene), quantity) for m in ("fem", "plate-midedge"))
-    assert fem is not None and midedge is not None, (fem, midedge)
-    assert abs(midedge.value - fem.value) <= midedge.error_bar + fem.error_bar, (midedge, fem)
+    fem, midedge = (_study(m, *scene) for m in ("fem", "plate-midedge"))
+    assert_agreement_where_decided(midedge, fem, quantity)
 
 
 #: The error map's scenes (fem_reference.gold.MAP_SCENES), checked by the same rule where both
-#: studies have the threshold (at L/b = 4000 both pass the fold of US since issue 31).
+#: studies have the threshold (at L/b = 4000 both pass the fold of US since issue 31). Measured: 14
+#: of the 17 entries decided, all within their combined error bars; undecided the dW2 at W/L = 1/8,
+#: 1/10 and 1/4, dL/L = 1/2 (combined 0.025-0.051 L).
 MAP_SCENES = [("dL0.5_W0.125", 0.5, 1 / 8), ("dL0.25_W0.125", 0.25, 1 / 8), ("dL0.5_W0.25", 0.5, 1 / 4),
               ("dL0.5_W0.05_Lb300", 0.5, 1 / 20), ("dL0.5_W0.1667_Lb300", 0.5, 1 / 6),
               ("dL0.25_W0.25", 0.25, 1 / 4), ("dL0.5_W0.1", 0.5, 1 / 10), ("dL0.25_W0.1", 0.25, 1 / 10),
@@ -119,13 +156,9 @@ def test_midedge_and_fem_agree_at_the_error_maps_scenes(request, scene, quantity
 
     fem, midedge = (load_study(m, c, w, name=name) for m in ("fem", "plate-midedge"))
     assert midedge is not None and len(midedge.meshes) >= 3, f"no complete mid-edge study of {name}"
-    from validation.claims import threshold_agreement
-
     if fem.threshold(quantity) is None:
         pytest.skip(f"the shell's study of {name} has no {quantity}")
-    agreement = threshold_agreement(midedge, fem, quantity)
-    assert agreement is not None, (name, quantity, midedge.threshold(quantity))
-    assert agreement.difference <= agreement.combined_error_bar, agreement
+    assert_agreement_where_decided(midedge, fem, quantity)
 
 
 @pytest.mark.parametrize("width", [1 / 6, 1 / 2], ids=["W1/6", "W1/2"])

@@ -32,49 +32,91 @@ COARSE_DW1, MIDDLE_DW1, MIDDLE_DW2, LOWEST_ORDER = 0.008, 0.003, 0.005, 1.5
 #: An observed order above 4 is no order (the asymptotic window of fem_reference.convergence).
 HIGHEST_ORDER = 4.0
 
+
+def _threshold_rule():
+    from validation.claims import CLAIMS
+
+    return CLAIMS["plate_vs_fem_narrow_thresholds"]
+
+
+#: How the report judges a threshold's agreement with the shell (bound 0.02 L, decided where the
+#: combined error bar is at most 0.02 L): assert_agreement_where_decided.
+THRESHOLD_RULE = _threshold_rule()
+
 #: Scenes whose mid-edge study has not been run yet (issue 29 item 3 in progress; resumable:
 #: `python -m validation.plate_gold --model plate-midedge --out data/midedge_gold --only NAME`).
 NOT_YET_RUN: list[str] = []  # whose study is not complete on its three meshes
 
-#: Measured misses, filled in from the studies as they were run: {test id: reason with figures}.
-MISSES: dict[str, str] = {
-    **{key: f"no complete mid-edge study of {name} stored yet (issue 29 item 3 in progress)"
-       for name in NOT_YET_RUN for key in (f"agree {name} dW1", f"agree {name} dW2", f"path {name}")},
-    "order W1/6": "issue 29 target not met: dL/L = 1/2, W/L = 1/6, dW1/L 0.2777/0.2710/0.2698 on 8/12/18 rows "
-                  "(differences -0.0067, -0.0012): observed order 4.21, outside [1.5, 4]; a 28-row run gives "
-                  "0.2681 (-0.0017 from 18 rows): not asymptotic",
-    "order W1/2": "issue 29 target not met: dL/L = 1/2, W/L = 1/2, dW1/L 0.1561/0.1578/0.1593 on 16/24/36 rows "
-                  "(rising, away from the FEM's 0.1566 +- 0.0008): observed order 0.50",
-    "coarse W1/6": "issue 29 target not met: dL/L = 1/2, W/L = 1/6, 8 rows dW1/L 0.2777, 0.0123 above the FEM's "
-                   "0.2654 (bound 0.008); 12 rows 0.2710, 0.0056 above (bound 0.003), dW2/L 0.4239, 0.0069 below "
-                   "0.4308 (bound 0.005)",
-    "coarse W1/2": "issue 29 target not met: dL/L = 1/2, W/L = 1/2, 16 rows dW1/L 0.1561 and 24 rows 0.1578 are "
-                   "within 0.008 and 0.003 of the FEM's 0.1566, but the 24-row dW2/L 0.3937 is 0.0526 above the "
-                   "FEM's 0.3411 (bound 0.005)",
-    "path dL0.5_W1/6": "issue 29 target not met: dL/L = 1/2, W/L = 1/6, 12 rows: U -> US -> S -> US -> S ... (9 "
-                       "phase changes, folds at dW/L 0.412, 0.424, 0.464, 0.536, 0.608 up to the last resolved "
-                       "state 0.638); 18 rows: U -> US -> S without a fold",
-    "path dL0.5_W1/2": "issue 29 target not met: dL/L = 1/2, W/L = 1/2, 24 rows: 14 folds from dW/L 0.279 up to the "
-                       "last resolved state 0.40; 36 rows: U -> US -> S -> US -> S, one fold (0.336)",
-    "path dL0.5_W1/3": "issue 29 target not met: dL/L = 1/2, W/L = 1/3, 24 rows: U -> US -> S -> US -> S, folds at "
-                       "dW/L 0.384, 0.413, 0.475 up to the last resolved state 0.525; 36 rows: U -> US -> S "
-                       "without a fold",
-    "path dL0.25_W1/12": "issue 29 target not met: dL/L = 1/4, W/L = 1/12, the snap to S taken in two folds less "
-                         "than 0.001 L apart (12 rows: dW/L 0.303, 0.304; 18 rows: both at 0.303)",
-    "path dL0.25_W1/6": "issue 29 target not met: dL/L = 1/4, W/L = 1/6, 12 rows: two folds at dW/L 0.261 and 0.262 "
-                        "(the snap to S taken in two); 18 rows: one fold (0.261)",
-    "path dL0.25_W1/2": "issue 29 target not met: dL/L = 1/4, W/L = 1/2, 36 rows: two folds at dW/L 0.1853 and 0.1855 "
-                        "(the snap to S taken in two); 24 rows: U -> US -> S without a fold",
-}
+#: Targets not met, as the studies were run: a strict expected failure each, whose reason the test
+#: computes from the data it asserts on (_order_figures, _coarse_figures, _path_figures), so the
+#: figures cannot go stale. Which targets are unmet is fixed here; only the figures are computed.
+UNMET = {"order W1/6", "order W1/2", "coarse W1/6", "coarse W1/2", "path dL0.5_W1/6", "path dL0.5_W1/2",
+         "path dL0.5_W1/3", "path dL0.25_W1/12", "path dL0.25_W1/6", "path dL0.25_W1/2",
+         "speed targets", "speedup"}
+NOT_RUN = {key: f"no complete mid-edge study of {name} stored yet (issue 29 item 3 in progress)"
+           for name in NOT_YET_RUN for key in (f"agree {name} dW1", f"agree {name} dW2", f"path {name}")}
 
 
 def _id(c, w):
     return f"dL{c:g}_W1/{round(1 / w)}"
 
 
-def _xfail_if_missed(request, key):
-    if key in MISSES:
-        request.applymarker(pytest.mark.xfail(strict=True, reason=MISSES[key]))
+def _xfail_if_not_run(request, key):
+    """A study not run yet: a strict expected failure (before the study is looked for)."""
+    if key in NOT_RUN:
+        request.applymarker(pytest.mark.xfail(strict=True, reason=NOT_RUN[key]))
+
+
+def _xfail_if_unmet(request, key, figures):
+    """A target not met (UNMET): a strict expected failure whose reason is figures(), called once
+    the data are loaded (missing data fail), and only an AssertionError is the expected miss."""
+    if key in UNMET:
+        request.applymarker(pytest.mark.xfail(strict=True, raises=AssertionError,
+                                              reason=f"issue 29 target not met: {figures()}"))
+
+
+def _scene_text(study) -> str:
+    return f"dL/L = {study.compression_ratio:g}, W/L = 1/{round(1 / study.width_ratio)}"
+
+
+def _f4(value) -> str:
+    return "none" if value is None else f"{value:.4f}"
+
+
+def _order_figures(study) -> str:
+    values = [m.dW1 for m in study.meshes]
+    steps = "" if None in values else " (differences " + ", ".join(
+        f"{b - a:+.4f}" for a, b in zip(values, values[1:])) + ")"
+    estimate = study.dW1
+    order = "no observed order" if estimate is None or estimate.order is None else \
+        f"observed order {estimate.order:.2f}, outside [{LOWEST_ORDER:g}, {HIGHEST_ORDER:g}]"
+    return (f"{_scene_text(study)}, dW1/L {'/'.join(_f4(v) for v in values)} on "
+            f"{'/'.join(m.label for m in study.meshes)}{steps}: {order}")
+
+
+def _coarse_figures(study, fem) -> str:
+    def off(value, reference):
+        if value is None:
+            return "none"
+        return f"{value:.4f}, {value - reference.value:+.4f} from the FEM's {reference.value:.4f}"
+    coarse, middle = study.meshes[0], study.meshes[1]
+    return (f"{_scene_text(study)}: {coarse.label} dW1/L {off(coarse.dW1, fem.dW1)} (bound {COARSE_DW1:g}); "
+            f"{middle.label} dW1/L {off(middle.dW1, fem.dW1)} (bound {MIDDLE_DW1:g}), dW2/L "
+            f"{off(middle.dW2, fem.dW2)} (bound {MIDDLE_DW2:g})")
+
+
+def _path_figures(study) -> str:
+    """The two finer meshes' paths: phases (the first five), folds up to the last resolved state."""
+    parts = []
+    for mesh in study.meshes[1:]:
+        phases, folds, resolved = path_transitions(mesh.folder)
+        shown = " -> ".join(phases[:5]) + (" ..." if len(phases) > 5 else "")
+        inside = [f for f in folds if f <= resolved]
+        where = ("without a fold" if not inside else
+                 f"{len(inside)} fold{'s' if len(inside) > 1 else ''} at dW/L " + ", ".join(f"{f:.4f}" for f in inside))
+        parts.append(f"{mesh.label}: {shown} ({len(phases) - 1} phase changes), {where} up to the last resolved "
+                     f"state {resolved:.3f}")
+    return f"{_scene_text(study)}, " + "; ".join(parts)
 
 
 def _study(model, c, w):
@@ -85,53 +127,87 @@ def _study(model, c, w):
     return study
 
 
+def assert_agreement_where_decided(midedge, fem, quantity):
+    """Issue 29's rule (|difference| <= the combined error bar) where the error bars can decide, as
+    the report's threshold claims judge (validation.claims.Claim.outcome_at with the bound and
+    error-bar limit of plate_vs_fem_narrow_thresholds, 0.02 L each): a combined error bar above
+    the limit cannot tell agreement from disagreement, so the entry is undecided and skipped (with
+    its figures), not counted as agreeing, unless the difference exceeds the bound even beyond the
+    combined error bar, which fails it. tests/test_readme.py counts the decided entries of
+    data/benchmark/benchmark.csv by the same rule."""
+    from validation.claims import threshold_agreement
+
+    agreement = threshold_agreement(midedge, fem, quantity)
+    assert agreement is not None, (quantity, midedge.threshold(quantity), fem.threshold(quantity))
+    difference, combined = agreement.difference, agreement.combined_error_bar
+    outcome = THRESHOLD_RULE.outcome_at(difference, combined)
+    assert outcome != "fails", (agreement, outcome)
+    if combined > THRESHOLD_RULE.error_bar_limit:
+        pytest.skip(f"undecided: {agreement.where}: |difference| {difference:.4f} L, combined error bar "
+                    f"{combined:.4f} L > {THRESHOLD_RULE.error_bar_limit:g} L (validation.claims)")
+    assert difference <= combined, agreement
+
+
 @pytest.mark.parametrize("quantity", ["dW1", "dW2"])
 @pytest.mark.parametrize("scene", SCENES, ids=[_id(*s) for s in SCENES])
 def test_midedge_and_fem_thresholds_agree_within_their_combined_error_bars(request, scene, quantity):
-    _xfail_if_missed(request, f"agree {_id(*scene)} {quantity}")
+    """Where the error bars decide (assert_agreement_where_decided); measured on the committed
+    studies: 15 of the 20 entries decided, all within their combined error bars (|diff|/combined at
+    most 0.74); undecided the dW1 at dL/L = 1/2, W/L = 1/6 (combined 0.023 L) and the dW2 at
+    dL/L = 1/2, W/L = 1/6, 1/3, 1/2 and dL/L = 1/4, W/L = 1/2 (0.14-0.23 L)."""
+    _xfail_if_not_run(request, f"agree {_id(*scene)} {quantity}")
     assert len(_study("plate-midedge", *scene).meshes) >= 3, "a study rests on three meshes"
-    fem, midedge = (getattr(_study(m, *scene), quantity) for m in ("fem", "plate-midedge"))
-    assert fem is not None and midedge is not None, (fem, midedge)
-    assert abs(midedge.value - fem.value) <= midedge.error_bar + fem.error_bar, (midedge, fem)
+    fem, midedge = (_study(m, *scene) for m in ("fem", "plate-midedge"))
+    assert_agreement_where_decided(midedge, fem, quantity)
 
 
 #: The error map's scenes (fem_reference.gold.MAP_SCENES), checked by the same rule where both
-#: studies have the threshold (at L/b = 4000 both pass the fold of US since issue 31).
+#: studies have the threshold (at L/b = 4000 both pass the fold of US since issue 31). Measured: 14
+#: of the 17 entries decided, all within their combined error bars; undecided the dW2 at W/L = 1/8,
+#: 1/10 and 1/4, dL/L = 1/2 (combined 0.025-0.051 L).
 MAP_SCENES = [("dL0.5_W0.125", 0.5, 1 / 8), ("dL0.25_W0.125", 0.25, 1 / 8), ("dL0.5_W0.25", 0.5, 1 / 4),
               ("dL0.5_W0.05_Lb300", 0.5, 1 / 20), ("dL0.5_W0.1667_Lb300", 0.5, 1 / 6),
               ("dL0.25_W0.25", 0.25, 1 / 4), ("dL0.5_W0.1", 0.5, 1 / 10), ("dL0.25_W0.1", 0.25, 1 / 10),
               ("dL0.5_W0.05_Lb4000", 0.5, 1 / 20)]
-MAP_MISSES: dict[str, str] = {
-    "dL0.5_W0.1667_Lb300 dW2": "no mid-edge dW2 reported at W/L = 1/6, L/b = 300: the paths reach S at dW/L "
-                               "0.4560/0.4545/0.4537 (8/12/18 rows; the shell 0.4541 +- 0.0004), but the membrane "
-                               "strain reaches 0.0229/0.0224/0.0217 > 0.02 (the small-strain limit of "
-                               "ddg.protocol.validity) there, so each run withholds its dW2 as unresolved",
-}
+#: (scene, quantity) not met: a strict expected failure whose reason _withheld_figures computes.
+MAP_UNMET = {"dL0.5_W0.1667_Lb300 dW2"}
+
+
+def _withheld_figures(name, quantity, midedge, fem) -> str:
+    """Why the mid-edge study has no `quantity`: each mesh's withheld value and its reason (the
+    small-strain limit of ddg.protocol.validity), against the shell's."""
+    key = f"{quantity}_over_L"
+    parts = []
+    for mesh in midedge.meshes:
+        summary = json.loads((mesh.folder / "summary.json").read_text())
+        withheld = (summary.get("unresolved_thresholds") or {}).get(key)
+        parts.append(f"{mesh.label}: " + ("reported" if withheld is None else
+                                          f"{withheld['value']:.4f} withheld: {withheld['reason']}"))
+    shell = fem.threshold(quantity)
+    return (f"no mid-edge {quantity} reported at {name} (the shell's {_f4(shell and shell.value)} +- "
+            f"{_f4(shell and shell.error_bar)}): " + "; ".join(parts))
 
 
 @pytest.mark.parametrize("quantity", ["dW1", "dW2"])
 @pytest.mark.parametrize("scene", MAP_SCENES, ids=[s[0] for s in MAP_SCENES])
 def test_midedge_and_fem_agree_at_the_error_maps_scenes(request, scene, quantity):
     name, c, w = scene
-    if f"{name} {quantity}" in MAP_MISSES:
-        request.applymarker(pytest.mark.xfail(strict=True, reason=MAP_MISSES[f"{name} {quantity}"]))
     from validation.estimates import load_study
 
     fem, midedge = (load_study(m, c, w, name=name) for m in ("fem", "plate-midedge"))
     assert midedge is not None and len(midedge.meshes) >= 3, f"no complete mid-edge study of {name}"
-    from validation.claims import threshold_agreement
-
+    if f"{name} {quantity}" in MAP_UNMET:
+        request.applymarker(pytest.mark.xfail(strict=True, raises=AssertionError,
+                                              reason=_withheld_figures(name, quantity, midedge, fem)))
     if fem.threshold(quantity) is None:
         pytest.skip(f"the shell's study of {name} has no {quantity}")
-    agreement = threshold_agreement(midedge, fem, quantity)
-    assert agreement is not None, (name, quantity, midedge.threshold(quantity))
-    assert agreement.difference <= agreement.combined_error_bar, agreement
+    assert_agreement_where_decided(midedge, fem, quantity)
 
 
 @pytest.mark.parametrize("width", [1 / 6, 1 / 2], ids=["W1/6", "W1/2"])
 def test_midedge_dW1_sequence_is_monotone_and_converges_at_order_1_5(request, width):
-    _xfail_if_missed(request, f"order W1/{round(1 / width)}")
     study = _study("plate-midedge", 0.5, width)
+    _xfail_if_unmet(request, f"order W1/{round(1 / width)}", lambda: _order_figures(study))
     values = [m.dW1 for m in study.meshes]
     assert None not in values and len(values) >= 3, values
     steps = [b - a for a, b in zip(values, values[1:])]
@@ -141,8 +217,8 @@ def test_midedge_dW1_sequence_is_monotone_and_converges_at_order_1_5(request, wi
 
 @pytest.mark.parametrize("width", [1 / 6, 1 / 2], ids=["W1/6", "W1/2"])
 def test_coarse_midedge_meshes_are_within_the_issues_bounds_of_the_fem(request, width):
-    _xfail_if_missed(request, f"coarse W1/{round(1 / width)}")
     fem, study = _study("fem", 0.5, width), _study("plate-midedge", 0.5, width)
+    _xfail_if_unmet(request, f"coarse W1/{round(1 / width)}", lambda: _coarse_figures(study, fem))
     coarse, middle = study.meshes[0], study.meshes[1]
     assert abs(coarse.dW1 - fem.dW1.value) <= COARSE_DW1, (coarse.label, coarse.dW1, fem.dW1)
     assert abs(middle.dW1 - fem.dW1.value) <= MIDDLE_DW1, (middle.label, middle.dW1, fem.dW1)
@@ -191,9 +267,10 @@ def shell_drops_at(folder: Path, dw: float) -> bool:
 def test_midedge_path_leaves_U_continuously_and_reaches_S_through_one_transition(request, scene):
     """At most one fold (the snap to S) up to the last resolved state on the two finer meshes,
     besides the folds of PHYSICAL_FOLDS, which the shell's finest run must show as well."""
-    _xfail_if_missed(request, f"path {_id(*scene)}")
+    _xfail_if_not_run(request, f"path {_id(*scene)}")
     study = _study("plate-midedge", *scene)
     assert len(study.meshes) >= 3
+    _xfail_if_unmet(request, f"path {_id(*scene)}", lambda: _path_figures(study))
     physical = PHYSICAL_FOLDS.get(_id(*scene), [])
     if physical:
         shell = _study("fem", *scene).meshes[-1].folder
@@ -208,30 +285,105 @@ def test_midedge_path_leaves_U_continuously_and_reaches_S_through_one_transition
         assert len(other) <= 1, (mesh.label, folds, resolved)
 
 
+# ---------------------------------------------------------------------------- locking (data/midedge_locking)
+#: The membrane-locking study (validation/locking.py, docs/findings/benchmark.md "Membrane locking of
+#: the mid-edge plate"): its committed runs, checked against each other and against this code.
+LOCKING = ROOT / "data" / "midedge_locking"
+
+
+def _locking_runs() -> dict:
+    summary = json.loads((LOCKING / "summary.json").read_text())
+    return {(r["slenderness"], r["membrane"], r["rows"]): r for r in summary["runs"]}
+
+
+def test_the_psri_membrane_removes_the_thickness_dependence_of_the_coarse_pitchfork():
+    """The locking diagnosis (validation/locking.py, stored runs): on 8 rows the constant-strain
+    membrane's dW1/L moves from 0.2774 (L/b = 300) to 0.3056 (1181), 0.028 L, where the converged
+    shell moves by -0.004 (0.2692 on 96 x 12 at 300; 0.2654 +- 0.0031 at 1181): spurious membrane
+    energy growing as (L/b)^2. With the PSRI membrane: 0.2773 and 0.2777. Bounds: the locked shift
+    above 0.02 L; the PSRI shift below 0.002 L (a tenth of the locked one; the 8-row discretisation
+    error, 0.012, is what remains and is not locking)."""
+    runs = _locking_runs()
+    full = [runs[(s, "full", 8)]["dW1_over_L"] for s in (300.0, 1181.1)]
+    psri = [runs[(s, "psri", 8)]["dW1_over_L"] for s in (300.0, 1181.1)]
+    assert full[1] - full[0] > 0.02, full
+    assert abs(psri[1] - psri[0]) < 0.002, psri
+
+
+def _rerun_locking(tmp_path, slenderness, membrane, rows=8):
+    """A committed locking run rerun as validation.locking runs it: the same dW1 to its bisection
+    tolerance (1e-4 L) and the same stretching shares along U to 1e-6 (a hundredth of the last digit
+    locking.md and the findings quote). Measured with this code against the runs stored before issue
+    31 changed the path's substeps: dW1 within 2e-12 (L/b = 300) and 7e-11 (1181), shares within
+    1.1e-11."""
+    from validation import locking
+
+    stored = _locking_runs()[(slenderness, membrane, rows)]
+    summary = locking.run_plate(slenderness, rows, membrane, tmp_path / "run")
+    assert summary["status"] == stored["status"] == "complete", summary["message"]
+    assert summary["dW1_over_L"] == pytest.approx(stored["dW1_over_L"], abs=1e-4)
+    rerun = locking.tabulate_run(tmp_path / "run")
+    assert rerun.keys() == stored["stretching_share"].keys()
+    for dw, share in stored["stretching_share"].items():
+        assert rerun[dw] == pytest.approx(share, abs=1e-6), dw
+
+
+def test_the_stored_locking_run_is_what_the_code_computes(tmp_path):
+    """The committed 8-row PSRI run at L/b = 300 (about 6 s): _rerun_locking."""
+    _rerun_locking(tmp_path, 300.0, "psri")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("membrane", ["psri", "full"])
+def test_the_stored_locking_runs_at_the_papers_slenderness_are_what_the_code_computes(tmp_path, membrane):
+    """The two 8-row runs at L/b = 1181 whose dW1 the findings quote (0.2777 with PSRI, 0.3056 with
+    the full membrane; 11-12 s each): _rerun_locking. Run with `pytest -m slow -k locking`."""
+    _rerun_locking(tmp_path, 1181.1, membrane)
+
+
 #: Issue 29's speed targets as the stored benchmarks measured them (benchmarks/results/: midedge_path.json,
-#: best of 3 warm calls of benchmarks/plate_path.py --model plate-midedge --rows 8 12 --repeat 3, idle
-#: machine, OpenBLAS on one thread; speed_accuracy.json, benchmarks/speed_accuracy.py). The tests read
-#: the stored benchmarks; they time nothing.
-SPEED_MISSES = {
-    "targets": "issue 29 target not met: W/L = 1/6, dL/L = 1/2, full path with thresholds: 8 rows 23.83 s "
-               "(target 8 s), 12 rows 55.22 s (target 20 s); 12.83 and 11.58 Newton iterations per recorded step "
-               "(target 6): of the 2066 iterations on 8 rows, 342 are in failed solves, 434 in fold snaps and 224 "
-               "in branch switching (19 branch switches along the path)",
-    "speedup": "issue 29 target not met (speed_accuracy.md, W/L = 1/6, dL/L = 1/2, idle machine): the cheapest "
-               "mid-edge run within 0.003 L of the FEM's converged dW1/L (0.2654 +- 0.0031) is 28 rows, 711.8 s "
-               "(error 0.0027); the FEM's is 96 x 12, 175.2 s (error 0.0017): FEM time / mid-edge time 0.25 against "
-               "the 10 asked; the benchmark's rule says 'undecided': the reference's own bar (0.00306) exceeds the "
-               "0.003 compared at",
-}
+#: warm calls of benchmarks/plate_path.py --model plate-midedge --rows 8 12, idle machine, OpenBLAS on one
+#: thread; speed_accuracy.json, benchmarks/speed_accuracy.py). The tests read the stored benchmarks; they
+#: time nothing. Both targets are unmet: strict expected failures whose reasons are computed from them.
+def _speed_targets_figures(stored: dict) -> str:
+    """The stored benchmark's wall times and iterations per recorded step against the targets, and
+    where the 8-row run's iterations go."""
+    runs = "; ".join(f"{t['rows']} rows {t['wall_time_s']:.2f} s (target {t['wall_target_s']:g} s), "
+                     f"{t['iterations_per_step']:.2f} Newton iterations per recorded step "
+                     f"(target {t['iterations_per_step_target']:g})" for t in stored["targets"])
+    first = min(stored["results"], key=lambda r: r["rows_target"])
+    phases = first["newton_iterations_by_phase"]
+    return (f"W/L = 1/6, dL/L = 1/2, full path with thresholds (benchmarks/results/midedge_path.json): {runs}; of "
+            f"the {first['newton_iterations']} iterations on {first['rows_target']} rows, "
+            f"{phases['rejected steps']} are in failed solves, {phases['fold snaps']} in fold snaps and "
+            f"{phases['branch switching']} in branch switching ({len(first['branch_switches_dW_over_L'])} "
+            f"recorded steps with a branch switch)")
+
+
+def _speedup_figures(stored: dict) -> str:
+    """The speed-accuracy benchmark's verdict on the 10x target, with its figures."""
+    verdict, reference = stored["verdict"], stored["reference"]["dW1"]
+    cheapest = verdict["cheapest_within_target"]
+
+    def entry(model):
+        e = cheapest.get(model)
+        return "none" if e is None else f"{e['entry']}, {e['wall_time_s']:.1f} s (error {e['dW1_error']:.4f})"
+    ratio = "none" if verdict.get("ratio") is None else f"{verdict['ratio']:.2f}"
+    return (f"(benchmarks/results/speed_accuracy.json, W/L = 1/6, dL/L = 1/2): the cheapest mid-edge run within "
+            f"{verdict['target_dW1_error_over_L']:g} L of the FEM's converged dW1/L ({reference['value']:.4f} +- "
+            f"{reference['error_bar']:.4f}) is {entry('plate-midedge')}; the FEM's is {entry('fem')}: FEM time / "
+            f"mid-edge time {ratio} against the {verdict['target_speedup']:g} asked; the benchmark's rule says "
+            f"'{verdict['verdict']}': {verdict['reason']}")
 
 
 def _stored_benchmark(name: str) -> dict:
     return json.loads((ROOT / "benchmarks" / "results" / f"{name}.json").read_text())
 
 
-@pytest.mark.xfail(strict=True, reason=SPEED_MISSES["targets"])
-def test_midedge_plate_meets_the_issues_speed_targets_in_the_stored_benchmark():
-    targets = {t["rows"]: t for t in _stored_benchmark("midedge_path")["targets"]}
+def test_midedge_plate_meets_the_issues_speed_targets_in_the_stored_benchmark(request):
+    stored = _stored_benchmark("midedge_path")
+    _xfail_if_unmet(request, "speed targets", lambda: _speed_targets_figures(stored))
+    targets = {t["rows"]: t for t in stored["targets"]}
     assert set(targets) == {8, 12}, sorted(targets)
     for rows, t in targets.items():
         assert t["completed"], (rows, t)
@@ -239,9 +391,9 @@ def test_midedge_plate_meets_the_issues_speed_targets_in_the_stored_benchmark():
         assert t["iterations_per_step"] <= t["iterations_per_step_target"] == 6.0, (rows, t)
 
 
-@pytest.mark.xfail(strict=True, reason=SPEED_MISSES["speedup"])
-def test_midedge_plate_is_ten_times_faster_than_the_fem_at_equal_dW1_error_in_the_stored_benchmark():
+def test_midedge_plate_is_ten_times_faster_than_the_fem_at_equal_dW1_error_in_the_stored_benchmark(request):
     stored = _stored_benchmark("speed_accuracy")
+    _xfail_if_unmet(request, "speedup", lambda: _speedup_figures(stored))
     rule = stored["rule"]
     assert rule["target_dW1_error_over_L"] == 0.003 and rule["target_speedup"] == 10.0, rule
     assert stored["verdict"]["verdict"] == "met", stored["verdict"]

@@ -29,19 +29,32 @@ def _solve_at_shear(model, state, shear_ratio, limit):
         model.restore_frames(saved)
 
 
+#: Without the contraction test a jump outside the basin spends at least this many iterations before
+#: it is given up: twice the 4 the test allows. Measured 15 (the whole budget, "no convergence") at
+#: every jump on the AMD EPYC the suite was written on; on an Intel Xeon, and here with
+#: OPENBLAS_CORETYPE=Prescott, the jump to dW = 0.1 L fails its line search at the 14th instead: a
+#: diverging iteration amplifies the BLAS kernels' round-off, so its count is not asserted.
+MANY_ITERATIONS = 8
+
+
 @pytest.mark.parametrize("shear_ratio", [0.05, 0.1, 0.2, 0.3])
 def test_a_step_far_outside_the_basin_is_given_up_within_four_iterations(compressed_rod, shear_ratio):
-    """Measured: without the test each of these jumps spends all 15 iterations (or fails its line
-    search at the 15th) before the step is halved; with it they stop after 1-4."""
+    """With the test the jumps stop after 1-4 iterations (measured on five OpenBLAS kernels; the
+    contraction ratios that stop them, 0.78-1.22, are far from the limit 0.5, so round-off does not
+    move the decision); without it the same jumps run on, until the iteration budget or a failed
+    line search ends them."""
     model, state = compressed_rod
     without = _solve_at_shear(model, state, shear_ratio, None)
     with_test = _solve_at_shear(model, state, shear_ratio, 0.5)
-    assert not without.converged and without.iterations == 15
     assert not with_test.converged and with_test.iterations <= 4
     assert "not contracting" in with_test.message
+    assert not without.converged and "not contracting" not in without.message
+    assert without.iterations >= MANY_ITERATIONS, without.message
 
 
 def test_a_step_inside_the_basin_is_the_same_with_and_without_the_test(compressed_rod):
+    """Exact equality on purpose: a converging step on the same code path, and the test only reads
+    the corrections' norms, so both solves do the same arithmetic on any CPU."""
     model, state = compressed_rod
     without = _solve_at_shear(model, state, 1e-3, None)
     with_test = _solve_at_shear(model, state, 1e-3, 0.5)

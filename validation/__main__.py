@@ -7,7 +7,9 @@ import sys
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m validation")
+    from ddg.cli_parser import OneLineParser  # one-line parse errors, exit 2
+
+    parser = OneLineParser(prog="python -m validation")
     sub = parser.add_subparsers(dest="command", required=True)
     rep = sub.add_parser("report", help="run the models on the paper's scenes and write DIR/index.html, report.md")
     group = rep.add_mutually_exclusive_group()

@@ -45,7 +45,6 @@ rows are made by the client. A worker killed mid-run costs that run, which is re
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import hashlib
 import json
@@ -59,6 +58,7 @@ import numpy as np
 
 from ddg.advise import (NOT_RUN, QUANTITIES, RULE_V1_MARGIN, at_scene, basis_scenes, choose, compared_at,
                         cross_validated_margin, fitting, map_scenes, measured_error, parse_rows, scene_name)
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import (StoredRun, atomic_write_text, finished_run_summary, finite_float, save_figure,
                           write_table_csv)
 from ddg.solve.probe import Probe
@@ -866,7 +866,7 @@ def main(argv=None) -> int:
     from ddg.output.io import check_output_directory
     from ddg.sweep import cluster
 
-    parser = argparse.ArgumentParser(prog="python -m validation.error_map", description=__doc__.split("\n")[0])
+    parser = OneLineParser(prog="python -m validation.error_map", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/error_map", help="output directory (default data/error_map)")
     parser.add_argument("--only", nargs="+", default=None,
                         help="scenes to (re)compute, e.g. dL0.5_W0.05 or dL0.5_W0.05_Lb300 (default all)")

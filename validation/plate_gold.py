@@ -26,13 +26,13 @@ stopped short, 1 if one failed (one line each on stderr).
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import sys
 import time
 from pathlib import Path
 
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, finished_run_summary, read_json_object
 
 from .estimates import DDG_TOLERANCES, load_study  # DDG_TOLERANCES: also read from here by benchmarks/
@@ -222,7 +222,7 @@ def main(argv=None) -> int:
     from ddg.sweep.grid import code_version
     from fem_reference.gold import all_scenes, scenes
 
-    parser = argparse.ArgumentParser(prog="python -m validation.plate_gold", description=__doc__.split("\n")[0])
+    parser = OneLineParser(prog="python -m validation.plate_gold", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/plate_gold")
     parser.add_argument("--only", nargs="*", default=None)
     parser.add_argument("--levels", type=int, default=LEVELS)

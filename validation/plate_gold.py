@@ -218,6 +218,7 @@ def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
     from ddg.output.interrupts import deferred_signals, exit_code_of, signal_name_of, terminate_as_interrupt
     from ddg.output.io import check_output_directory
+    from ddg.solve.blas_threads import requested_threads
     from ddg.sweep import cluster
     from ddg.sweep.grid import code_version
     from fem_reference.gold import all_scenes, scenes
@@ -243,7 +244,8 @@ def main(argv=None) -> int:
             raise InputError(f"--levels = {args.levels} outside 1..4")
         scheduler, workers, retries = cluster.checked_options(args.scheduler, args.workers, args.retries)
         if not args.studies_only:
-            scheduler = cluster.ready(scheduler, workers)
+            requested_threads()   # a bad DDG_BLAS_THREADS would fail every run on its worker
+            scheduler = cluster.ready(scheduler, workers)   # connected to first: then --out is made
         out = check_output_directory(args.out, "--out")
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -14,17 +14,11 @@ import math
 import sys
 from pathlib import Path
 
+from .cli_parser import EXIT_BAD_INPUT, OneLineParser
 from .geometry.strip import InputError, LoadingProtocol, Strip
 
-EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
 EXIT_INTERNAL = 1
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit 2, no usage dump
-        sys.stderr.write(f"error: {message}\n")
-        raise SystemExit(EXIT_BAD_INPUT)
 
 
 #: --model choices of simulate: the plates, the rod and the ribbons (ddg.api.DEFAULT_RESOLUTION).
@@ -33,8 +27,9 @@ MODEL_CHOICES = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", 
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="python -m ddg", description="DDG solvers for pre-buckled strips under shear.")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    # parse errors are one line and exit 2 (ddg.cli_parser), as every command line of the project
+    parser = OneLineParser(prog="python -m ddg", description="DDG solvers for pre-buckled strips under shear.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
     sim = sub.add_parser("simulate", help="compress by dL, then shear by dW; write path.csv and summary.json")
     sim.add_argument("--model", default="rod", choices=MODEL_CHOICES + ("auto",),
                      help="rod (DAR, default), plate (DEP on a triangle mesh), plate-midedge (mid-edge "

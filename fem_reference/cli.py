@@ -14,20 +14,14 @@ import json
 import os
 import sys
 
+from ddg.cli_parser import EXIT_BAD_INPUT, OneLineParser
 from ddg.sweep.cluster import add_options as cluster_options
 
 from .elements import DEFAULT_ELEMENT, ELEMENTS
 from .scene import add_scene_options, scene_from_args
 
 EXIT_FAILURE = 1
-EXIT_BAD_INPUT = 2
 EXIT_NOT_CONVERGED = 3
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit 2, no usage dump (as ddg.cli)
-        sys.stderr.write(f"error: {' '.join(str(message).split())}\n")
-        raise SystemExit(EXIT_BAD_INPUT)
 
 
 #: Option names of the command line, for api.check_inputs' messages.
@@ -88,8 +82,9 @@ def cmd_gold(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="python -m fem_reference", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    # parse errors: one line, exit 2 (ddg.cli_parser, the one parser of every command line)
+    parser = OneLineParser(prog="python -m fem_reference", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
     p = sub.add_parser("simulate", help="one run: path.csv, summary.json, centerline.csv, fields.xdmf")
     add_scene_options(p)
     p.add_argument("--resolution", type=int, default=60,

@@ -164,16 +164,17 @@ def _finished(summary: dict | None, along: int, across: int) -> bool:
         (tolerances.get("dW1"), tolerances.get("dW2")) == GOLD_TOLERANCES
 
 
-def cluster_inputs(args) -> tuple[str | None, int | None, int]:
+def cluster_inputs(args, check: bool = True) -> tuple[str | None, int | None, int]:
     """(scheduler, workers, retries) of --scheduler, --workers, --retries, checked
     (ddg.sweep.cluster.checked_options), and dask importable unless --studies-only: the scheduler
-    to use, None for a LocalCluster. One-line InputError otherwise."""
+    to use, None for a LocalCluster. With `check`, a scheduler is connected to once
+    (ddg.sweep.cluster.ready), before check_gold_inputs creates --out. One-line InputError otherwise."""
     from ddg.sweep.cluster import checked_options, ready
 
     scheduler, workers, retries = checked_options(getattr(args, "scheduler", None), getattr(args, "workers", None),
                                                   getattr(args, "retries", 2))
     if not getattr(args, "studies_only", False):
-        scheduler = ready(scheduler, workers)
+        scheduler = ready(scheduler, workers, check)
     return scheduler, workers, retries
 
 
@@ -225,7 +226,7 @@ def run_gold(args) -> int:
         write_index(out)
         return 0
 
-    scheduler, workers, retries = cluster_inputs(args)
+    scheduler, workers, retries = cluster_inputs(args, check=False)   # check_gold_inputs connected to it
     where = hashlib.sha256(str(out.resolve()).encode()).hexdigest()[:8]
     tasks = []
     for name, dL, W, slenderness, meshes in selected:

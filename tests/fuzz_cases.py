@@ -12,7 +12,8 @@ Placeholders in argv: {tmp} is the case's temporary directory (cwd of the case),
 output directory inside it. Every case's {tmp} holds file.txt (a regular file), empty.msh (an
 empty file), dir/ (an empty directory), garbage.msh (binary noise), header.msh (a gmsh header
 without nodes), mesh.xyz (an unknown format), loop (a symlink to itself), dangling (a symlink to
-nothing), run-corrupt/ (summary.json not JSON) and run-keys/ (summary.json without the keys).
+nothing), run-corrupt/ (summary.json not JSON), run-keys/ (summary.json without the keys), fifo (a
+named pipe: opening it for reading blocks) and the results files of `validation score` (RESULTS_FILES).
 
 Everything is deterministic: no random numbers, the same cases in the same order on every run.
 """
@@ -31,11 +32,15 @@ RUN = "run"         # valid edge case, run for real on a tiny scene (about 1 s e
 @dataclass(frozen=True)
 class Case:
     id: str
-    prog: str                     # "ddg", "fem" (the command lines) or "api"
+    prog: str                     # "ddg", "fem", "validation" or a validation module (the command lines), or "api"
     argv: tuple = ()
     option: str = ""              # the option or object under test, for grouping the failures
     expect: str = REFUSE
     call: Callable | None = field(default=None, compare=False)  # api: call(tmp_path)
+    env: tuple = ()               # (name, value) environment variables set for the case
+    names: str = ""               # the error line must contain it (the value refused)
+    untouched: bool = False       # the case's folder must be as it was: nothing created, nothing changed
+    limit_s: float = 0.0          # a hard time limit below the file's 30 s (a read that could block)
 
 
 # ----------------------------------------------------------------------------------- base commands
@@ -358,8 +363,14 @@ def subprocess_cases() -> list[Case]:
         ("simulate-resolution-100000000", FEM_SIMULATE + ("--resolution=100000000",)),
         ("convergence-table-runs-missing", ("convergence-table", "--runs", "{tmp}/missing", "--out={out}")),
     )
+    validation_cases = (   # issue 47 item 3: python -m validation[.module], the real program
+        ("validation", "score-unknown-option", SCORE + ("--spaghetti",)),
+        ("validation", "score-results-fifo", ("score", "{tmp}/fifo", "--out={out}")),
+        ("validation.error_map", "only-spaghetti", ERROR_MAP + ("--only=spaghetti",)),
+    )
     return ([Case(f"subprocess-ddg-{label}", "ddg", argv, label) for label, argv in ddg_cases]
-            + [Case(f"subprocess-fem-{label}", "fem", argv, label) for label, argv in fem_cases])
+            + [Case(f"subprocess-fem-{label}", "fem", argv, label) for label, argv in fem_cases]
+            + [Case(f"subprocess-{prog}-{label}", prog, argv, label) for prog, label, argv in validation_cases])
 
 
 # ----------------------------------------------------------------------------------- API cases
@@ -620,8 +631,119 @@ def api_valid_cases() -> list[Case]:
     return [Case(f"valid-api-{case_id}", "api", option=obj, expect=ACCEPT, call=call) for case_id, obj, call in rows]
 
 
+# ----------------------------------------------------------------------------------- issue 47 item 3
+#: Every bad input answered (issue 47 item 3): the command lines of validation and the sweep. Each case
+#: must exit 2 with one `error:` line naming the value, before any work, and leave its folder as it was
+#: (untouched: no --out, no runs/ or cache/, an existing --out unchanged).
+#: A scheduler address where nothing listens: refused at once (connection refused), not after 10 s.
+NO_SCHEDULER = "tcp://127.0.0.1:1"
+SWEEP = ("sweep", "--model=rod", "--width-ratios=0.05", "--compression-ratios=0.5", "--resolutions=20",
+         "--compression-steps=2", "--shear-steps=2", "--quiet", "--out={out}")
+SCORE = ("score", "{tmp}/results-ok.csv", "--out={out}")
+ERROR_MAP = ("--out={out}", "--only=dL0.5_W0.05", "--models=rod")
+PLATE_GOLD = ("--out={out}", "--only=dL0.5_W0.5", "--levels=1", "--quiet")
+REPORT = ("report", "--quick", "--quiet", "--out={out}")
+#: Each validation command with its own argparse main (validation/*.py) and a bad option value of its own.
+VALIDATION_MAINS = (("validation.benchmark", "--out"), ("validation.error_map", "--timeout=x"),
+                    ("validation.locking", "--out"), ("validation.narrow_limit", "--slenderness=x"),
+                    ("validation.paper_figures", "--out"), ("validation.plate_gold", "--levels=x"),
+                    ("validation.plate_mesh_scan", "--triangles=1"), ("validation.plate_modes", "--out"),
+                    ("validation.ribbon_regularisation", "--out"), ("validation.wide_check", "--rows=x"))
+#: A results file for `score` (validation/score.py's format): header and one scene.
+RESULTS_HEADER = ("kind,compression_ratio,width_ratio,slenderness,poisson_ratio,dW1_over_L,dW2_over_L,dW_over_L,"
+                  "H_mid_over_L\n")
+RESULTS_FILES = {
+    "results-ok.csv": RESULTS_HEADER + "thresholds,0.5,0.05,1181.1,0,0.35,0.47,,\n",
+    "results-1e308.csv": RESULTS_HEADER + "thresholds,0.5,0.05,1181.1,0,1e308,1.7e308,,\n",
+    "results-slenderness-1e308.csv": RESULTS_HEADER + "thresholds,0.5,0.05,1e308,0,0.35,0.47,,\n",
+    "results-H_mid-1e308.csv": RESULTS_HEADER + "H_mid,0.5,0.05,1181.1,0,,,0.1,-1e308\n",
+}
+
+
+def issue47_bad_cases() -> list[Case]:
+    cases: list[Case] = []
+
+    def add(case_id, prog, argv, option, names, **extra):
+        cases.append(Case(case_id, prog, tuple(argv), option, names=names, untouched=True, **extra))
+
+    # 1. score: values near the float range (crashed in the figure after writing score.csv), a FIFO (hung),
+    #    /dev/zero (read until MemoryError); and a template onto a FIFO (would be replaced by a file)
+    for name, value in (("results-1e308.csv", "1e+308"), ("results-slenderness-1e308.csv", "1e+308"),
+                        ("results-H_mid-1e308.csv", "-1e+308")):
+        add(f"validation-score-{name.removesuffix('.csv')}", "validation",
+            ("score", f"{{tmp}}/{name}", "--out={out}"), "RESULTS", value)
+    add("validation-score-results-fifo", "validation", ("score", "{tmp}/fifo", "--out={out}"), "RESULTS", "fifo",
+        limit_s=5.0)
+    add("validation-score-results-dev-zero", "validation", ("score", "/dev/zero", "--out={out}"), "RESULTS",
+        "/dev/zero", limit_s=10.0)
+    add("validation-score-template-fifo", "validation", ("score", "--template={tmp}/fifo"), "--template", "fifo",
+        limit_s=5.0)
+    # 2. DDG_BLAS_THREADS without a bound
+    for value in ("1000000000", "257"):
+        add(f"ddg-simulate-rod-env-DDG_BLAS_THREADS-{value}", "ddg", ddg_simulate("rod"), "DDG_BLAS_THREADS", value,
+            env=(("DDG_BLAS_THREADS", value),))
+    add("ddg-sweep-env-DDG_BLAS_THREADS-1000000000", "ddg", SWEEP, "DDG_BLAS_THREADS", "1000000000",
+        env=(("DDG_BLAS_THREADS", "1000000000"),))
+    # 3. a scheduler that cannot be reached: refused before any folder is made; an existing --out stays as it was
+    scheduler = f"--scheduler={NO_SCHEDULER}"
+    for label, prog, argv in (("ddg-sweep", "ddg", SWEEP), ("fem-gold", "fem", FEM_GOLD),
+                              ("validation.plate_gold", "validation.plate_gold", PLATE_GOLD),
+                              ("validation.error_map", "validation.error_map", ERROR_MAP),
+                              ("validation-report-quick", "validation", REPORT)):
+        add(f"{label}-scheduler-refused", prog, argv + (scheduler,), "--scheduler", NO_SCHEDULER)
+        existing = tuple("--out={tmp}/dir" if a == "--out={out}" else a for a in argv)
+        add(f"{label}-scheduler-refused-existing-out", prog, existing + (scheduler,), "--scheduler", NO_SCHEDULER)
+    # 4. the error map's own arguments
+    for option, value in (("--only", "spaghetti"), ("--models", "spaghetti"), ("--timeout", "-5"), ("--timeout", "0"),
+                          ("--timeout", "100000000"), ("--timeout", "2.5")):
+        add(f"validation.error_map-{option.lstrip('-')}-{_label(value)}", "validation.error_map",
+            ERROR_MAP + (f"{option}={value}",), option, value)
+    add("validation.error_map-only-known-and-unknown", "validation.error_map",
+        ERROR_MAP + ("--only", "dL0.5_W0.05", "spaghetti"), "--only", "spaghetti")
+    # 5. parse errors: one line, as the ddg commands give, from every command with its own argparse main
+    add("validation-score-unknown-option", "validation", SCORE + ("--spaghetti",), "arguments", "--spaghetti")
+    add("validation-report-jobs-x", "validation", REPORT + ("--jobs=x",), "arguments", "'x'")
+    add("validation-report-jobs-100000000", "validation", REPORT + ("--jobs=100000000",), "--jobs", "100000000")
+    add("validation-unknown-subcommand", "validation", ("spaghetti",), "arguments", "spaghetti")
+    for module, option in VALIDATION_MAINS:
+        short = module.split(".")[1]
+        add(f"{module}-unknown-option", module, ("--out={out}", "--spaghetti"), "arguments", "--spaghetti")
+        if option != "--out":
+            value = option.split("=")[1]
+            add(f"{module}-{option.split('=')[0].lstrip('-')}-{value}", module, ("--out={out}", option), "arguments",
+                f"'{value}'" if short != "plate_mesh_scan" else "--triangles")
+    add("validation.narrow_limit-slenderness-5", "validation.narrow_limit", ("--out={out}", "--slenderness=5"),
+        "--slenderness", "5")
+    return cases
+
+
+def issue47_valid_cases() -> list[Case]:
+    """The base commands of issue47_bad_cases, accepted up to their work (a tripwire); DDG_BLAS_THREADS at
+    its bound."""
+    cases = [Case(f"valid-{label}", prog, argv, "base", ACCEPT) for label, prog, argv in (
+        ("ddg-sweep", "ddg", SWEEP), ("validation-score", "validation", SCORE),
+        ("validation.error_map", "validation.error_map", ERROR_MAP),
+        ("validation.plate_gold", "validation.plate_gold", PLATE_GOLD), ("validation-report", "validation", REPORT))]
+    cases.append(Case("valid-ddg-simulate-rod-env-DDG_BLAS_THREADS-256", "ddg", ddg_simulate("rod"),
+                      "DDG_BLAS_THREADS", ACCEPT, env=(("DDG_BLAS_THREADS", "256"),)))
+    return cases
+
+
+def _sweep(**kwargs):
+    def call(tmp):
+        from ddg.sweep import run_sweep
+
+        run_sweep(["rod"], width_ratios=[0.05], compression_ratios=[0.5], resolutions=[20], compression_steps=2,
+                  shear_steps=2, out=str(tmp / "out"), **kwargs)
+    return call
+
+
 def all_in_process_cases() -> list[Case]:
     cases = ddg_bad_cases() + fem_bad_cases() + api_bad_cases() + valid_cases() + api_valid_cases()
+    cases += issue47_bad_cases() + issue47_valid_cases()
+    cases += [Case("api-run_sweep-scheduler-refused", "api", option="run_sweep", call=_sweep(scheduler=NO_SCHEDULER),
+                   names=NO_SCHEDULER, untouched=True),
+              Case("valid-api-run_sweep", "api", option="run_sweep", expect=ACCEPT, call=_sweep())]
     ids = [c.id for c in cases]
     duplicates = sorted({i for i in ids if ids.count(i) > 1})
     assert not duplicates, f"duplicate case ids: {duplicates}"

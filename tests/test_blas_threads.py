@@ -71,6 +71,21 @@ def test_a_bad_thread_count_is_refused_in_one_line(monkeypatch, value, tmp_path)
     assert not out.exists()
 
 
+@pytest.mark.parametrize("value", ["257", "1000000000", "9" * 400])
+def test_a_thread_count_beyond_the_bound_is_refused_naming_value_and_range(monkeypatch, value):
+    """Issue 47 item 3: DDG_BLAS_THREADS=1000000000 was accepted. At most MAX_THREADS (256); the command
+    lines refuse it before any work (exit 2: tests/test_fuzz_inputs.py)."""
+    from ddg.solve.blas_threads import MAX_THREADS
+
+    monkeypatch.setenv("DDG_BLAS_THREADS", str(MAX_THREADS))
+    assert requested_threads() == MAX_THREADS == 256
+    monkeypatch.setenv("DDG_BLAS_THREADS", value)
+    with pytest.raises(InputError) as refused:
+        requested_threads()
+    message = str(refused.value)
+    assert value[:40] in message and "[1, 256]" in message and "\n" not in message and len(message) < 200
+
+
 @pytest.mark.skipif(_control().kind != "openblas", reason="checks OpenBLAS's own setting")
 def test_nested_runs_restore_once_the_outermost_ends(monkeypatch):
     monkeypatch.delenv("DDG_BLAS_THREADS", raising=False)

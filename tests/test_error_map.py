@@ -343,3 +343,64 @@ def test_committed_map_held_out_scenes_are_those_with_a_finished_study():
     assert held <= finished
     entries = [e for e in em.held_out_check(rows, 0.01) if e["role"] == "held-out"]
     assert len(entries) == len(held)
+
+
+# ---------------------------------------------------------------------------- failed runs (issue 47 item 3)
+def test_a_failed_run_is_never_written_and_one_of_an_older_table_is_dropped(tmp_path):
+    """A row of status "error" (the run raised, or ran past --timeout) is not a measurement: put refuses
+    it and leaves the table as it was; one read from an older table is dropped at the next write."""
+    path = tmp_path / "map.csv"
+    good = {"scene": "dL0.5_W0.05_Lb1181", "model": "rod", "resolution": 50, "resolution_label": "M50",
+            "status": "complete", "source_hash": "a", "reference_hash": "r", "dW1_bound": 0.01}
+    table = em.Table(path)
+    assert table.put(good)
+    before = path.read_text()
+    assert not table.put({**good, "status": em.FAILED, "source_hash": "b", "reason": "run failed: _Timeout"})
+    assert path.read_text() == before and em.Table(path).current(("rod", "M50", "dL0.5_W0.05_Lb1181"), "a", "r")
+    old = [{**{c: "" for c in em.COLUMNS}, **good, "model": "ribbon", "resolution_label": "M51",
+            "status": em.FAILED}]
+    with open(path, "a", newline="") as fh:   # an error row written before this rule
+        csv.DictWriter(fh, fieldnames=em.COLUMNS).writerows(old)
+    again = em.Table(path)
+    assert [r["model"] for r in again.rows] == ["rod"]
+    assert again.put({**good, "resolution": 100, "resolution_label": "M100"})
+    assert {r["status"] for r in em.read_table(path)} == {"complete"} and len(em.read_table(path)) == 2
+
+
+def test_a_run_that_fails_is_reported_not_written_and_the_command_exits_1(tmp_path, monkeypatch, capsys):
+    """The whole command with the runs made in this process (run_all replaced): the run's error row is
+    refused, the older row of its key stays as it was, one line names the failure, exit 1."""
+    from ddg.sweep import cluster
+
+    found = [s for s in em.reference_scenes() if s.name == "dL0.25_W0.05_Lb787" and s.reference is not None]
+    if not found:
+        pytest.skip("the repository's FEM gold data (data/fem_gold) is not here")
+    scene = found[0].name
+
+    def in_process(tasks, finished, **options):
+        for task in tasks:
+            finished(task, task.function(*task.args), None)
+        return cluster.Ran(where="this process")
+
+    def failing(at, model, resolution, timeout):
+        return {"scene": at.name, "model": model, "resolution": resolution, "resolution_label": f"M{resolution}",
+                "status": em.FAILED, "reason": f"run failed: _Timeout: the run took more than {timeout:g} s"}
+
+    monkeypatch.setattr(cluster, "run_all", in_process)
+    monkeypatch.setattr(em, "run_row", failing)
+    monkeypatch.setattr(em, "rod_family", lambda: [("rod", (24,))])
+    monkeypatch.setattr(em, "figures", lambda rows, out: [])   # matplotlib: not what is tested here
+    out = tmp_path / "map"
+    committed = [r for r in committed_rows()
+                 if (r["scene"], r["model"], r["resolution_label"]) == (scene, "rod", "M50")]
+    older = {**committed[0], "resolution": "24", "resolution_label": "M24", "source_hash": "older sources"}
+    em.Table(out / em.CSV_NAME).put(older)
+    before = (out / em.CSV_NAME).read_text()
+    code = em.main(["--out", str(out), "--only", "dL0.25_W0.05", "--models", "rod", "--workers", "1",
+                    "--timeout", "5"])
+    err = capsys.readouterr().err.splitlines()
+    assert code == 1
+    assert err[0] == (f"error: {scene} rod M24: run failed: _Timeout: the run took more than 5 s; not written to "
+                      "the map (a rerun retries it)"), err
+    assert err[-1].startswith("error: 1 run(s) failed and are not in the map (first: "), err
+    assert (out / em.CSV_NAME).read_text() == before and (out / "README.md").exists()

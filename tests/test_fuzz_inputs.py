@@ -23,6 +23,15 @@ stops converging, never 2, never a traceback). A few bad cases also run as subpr
 (`python -m ddg|fem_reference`, cwd = the case's temporary directory, 30 s timeout) for the real
 exit code and output.
 
+Issue 47 item 3 ("every bad input answered") adds the validation command lines (`python -m
+validation score|report`, validation.error_map, validation.plate_gold and every other validation
+module with its own main; prog "validation" or the module's name), `ddg sweep` and run_sweep, the
+scheduler of fem_reference gold, and DDG_BLAS_THREADS (Case.env). Each of those cases must also name
+the refused value in its one line (Case.names) and leave its temporary folder exactly as it was
+(Case.untouched: no --out created, an existing --out unchanged, no runs/ or cache/); a read that
+could block (a FIFO) runs under a shorter alarm (Case.limit_s). The validation commands' own work is
+tripwired too (the scorecard, the template, the error map's rows, the report).
+
 Cases are generated deterministically from tables (fuzz_cases.BAD_VALUES: option -> bad
 values, crossed with every subcommand and model the option applies to; hand-written lists of
 incompatible options, unknown options and missing arguments; API calls), with ids such as
@@ -94,6 +103,14 @@ DDG_ENTRY_POINTS = (
     # the study generators and the sweep hand their runs to Dask workers here: past every check
     ("ddg.sweep.cluster", None, "run_all"),
 )
+#: Where the validation commands begin their work: the scorecard, the template, the error map's rows, the
+#: report's runs (each looked up in its module at the call, so the tripwire is what the command calls).
+VALIDATION_ENTRY_POINTS = (
+    ("validation.score", None, "score_results"),
+    ("validation.score", None, "write_template"),
+    ("validation.error_map", None, "build"),
+    ("validation.report", None, "build_report"),
+)
 FEM_ENTRY_POINTS = (
     ("fem_reference.mesh", None, "build_gmsh_model"),
     ("fem_reference.mesh", None, "create_mesh"),
@@ -108,10 +125,11 @@ def _tripwire(name):
     return tripped
 
 
-def install_tripwires(monkeypatch, fem: bool) -> None:
+def install_tripwires(monkeypatch, fem: bool, validation: bool = False) -> None:
     import importlib
 
-    for module_name, owner, attribute in DDG_ENTRY_POINTS + (FEM_ENTRY_POINTS if fem else ()):
+    for module_name, owner, attribute in DDG_ENTRY_POINTS + (FEM_ENTRY_POINTS if fem else ()) + \
+            (VALIDATION_ENTRY_POINTS if validation else ()):
         try:
             module = importlib.import_module(module_name)
         except ImportError:
@@ -166,7 +184,30 @@ def prepare(tmp_path: Path, monkeypatch) -> None:
         (tmp_path / name).mkdir()
         (tmp_path / name / "summary.json").write_text(text)
         (tmp_path / name / "path.csv").write_text("stage,dL_over_L\ncompression,x\n")
+    os.mkfifo(tmp_path / "fifo")   # opening it for reading blocks until a writer comes: never read it
+    for name, text in fuzz_cases.RESULTS_FILES.items():
+        (tmp_path / name).write_text(text)
     monkeypatch.chdir(tmp_path)  # a stray default ./out lands here, never in the repository
+
+
+def tree(folder: Path) -> dict[str, tuple]:
+    """Every entry under `folder` (symlinks not followed): relative path -> (mode, size, mtime)."""
+    out = {}
+    for root, dirs, files in os.walk(folder):
+        for name in dirs + files:
+            path = Path(root) / name
+            info = path.lstat()
+            out[str(path.relative_to(folder))] = (info.st_mode, info.st_size, info.st_mtime_ns)
+    return out
+
+
+def changes(before: dict, after: dict) -> str:
+    """What a case created, removed or changed in its folder, in words ('' if nothing)."""
+    created = sorted(set(after) - set(before))
+    removed = sorted(set(before) - set(after))
+    changed = sorted(k for k in set(before) & set(after) if before[k] != after[k])
+    return "; ".join(f"{what}: {', '.join(names[:4])}" for what, names in (("created", created), ("removed", removed),
+                                                                           ("changed", changed)) if names)
 
 
 def expand(argv, tmp_path: Path) -> list[str]:
@@ -176,8 +217,12 @@ def expand(argv, tmp_path: Path) -> list[str]:
 def _main(prog: str):
     if prog == "ddg":
         from ddg.cli import main
-    else:
+    elif prog == "fem":
         from fem_reference.cli import main
+    else:   # "validation" (python -m validation) or a module of validation with its own main
+        import importlib
+
+        main = importlib.import_module("validation.__main__" if prog == "validation" else prog).main
     return main
 
 
@@ -187,7 +232,7 @@ def run_cli_in_process(case: Case, tmp_path: Path, capfd) -> dict:
     outcome = {"code": None, "exception": None, "work": None, "timeout": None}
     t0 = time.perf_counter()
     try:
-        with guarded():
+        with guarded(case.limit_s or HARD_LIMIT_S):
             outcome["code"] = main(argv)
     except SystemExit as exc:
         code = exc.code
@@ -211,7 +256,7 @@ def run_api(case: Case, tmp_path: Path) -> dict:
     outcome = {"exception": None, "work": None, "timeout": None, "returned": False}
     t0 = time.perf_counter()
     try:
-        with guarded():
+        with guarded(case.limit_s or HARD_LIMIT_S):
             case.call(tmp_path)
         outcome["returned"] = True
     except WorkStarted as exc:
@@ -238,7 +283,7 @@ def cli_problem(outcome: dict) -> tuple[str, str] | None:
     """(cause, detail) of a bad command-line case that was not cleanly refused, else None."""
     err, out = outcome["err"], outcome["out"]
     if outcome["timeout"]:
-        return "timeout: still running after 30 s (computing)", outcome["timeout"]
+        return f"timeout: {outcome['timeout']} (computing, or blocked on a read)", outcome["timeout"]
     if outcome["work"]:
         return "not refused: computation started", f"reached {outcome['work']}"
     exc = outcome["exception"]
@@ -308,7 +353,10 @@ def fail(case: Case, problem, code, line) -> None:
 @pytest.mark.parametrize("case", IN_PROCESS, ids=[c.id for c in IN_PROCESS])
 def test_input(case: Case, tmp_path, monkeypatch, capfd):
     prepare(tmp_path, monkeypatch)
-    install_tripwires(monkeypatch, fem=case.prog == "fem")
+    install_tripwires(monkeypatch, fem=case.prog == "fem", validation=case.prog.startswith("validation"))
+    for name, value in case.env:
+        monkeypatch.setenv(name, value)
+    before = tree(tmp_path) if case.untouched else None
     if case.prog == "api":
         outcome = run_api(case, tmp_path)
         code = None
@@ -348,6 +396,12 @@ def test_input(case: Case, tmp_path, monkeypatch, capfd):
         else:
             problem = (f"valid input refused (exit {code})" if code == 2 else
                        f"valid input: did not reach the solver (exit {code})", line or outcome["timeout"] or "")
+    if problem is None and case.names and case.names not in line:
+        problem = ("the error line does not name the value", f"{case.names!r} not in the line")
+    if problem is None and before is not None:
+        touched = changes(before, tree(tmp_path))
+        if touched:
+            problem = ("refused, but its folder changed (made or written before the refusal)", touched)
     record(case, problem, code, line, outcome["seconds"])
     if problem is not None:
         fail(case, problem, code, line)
@@ -386,10 +440,10 @@ def _limit_memory():  # subprocess preexec: the same ceiling as in-process, abso
 def test_bad_input_in_a_subprocess(case: Case, tmp_path, monkeypatch):
     """The real program: exit 2, one `error:` line on stderr, no traceback, within 30 s."""
     prepare(tmp_path, monkeypatch)
-    module = "ddg" if case.prog == "ddg" else "fem_reference"
+    module = {"ddg": "ddg", "fem": "fem_reference"}.get(case.prog, case.prog)   # or validation[.module]
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH",
                                                                                   "")]).rstrip(os.pathsep),
-           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MPLBACKEND": "Agg"}
+           "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MPLBACKEND": "Agg", **dict(case.env)}
     t0 = time.perf_counter()
     try:
         proc = subprocess.run([sys.executable, "-m", module, *expand(case.argv, tmp_path)], cwd=tmp_path, env=env,
@@ -420,7 +474,9 @@ def test_case_counts():
     empty table after an edit)."""
     bad = [c for c in IN_PROCESS if c.expect == REFUSE]
     valid = [c for c in IN_PROCESS if c.expect == ACCEPT]
-    assert len(bad) >= 300 and len(valid) >= 30 and 5 <= len(RUNS) <= 10 and 10 <= len(SUBPROCESS) <= 13
+    assert len(bad) >= 300 and len(valid) >= 30 and 5 <= len(RUNS) <= 10 and 10 <= len(SUBPROCESS) <= 16
+    issue47 = [c for c in bad if c.untouched]   # issue 47 item 3: each names its value and leaves its folder
+    assert len(issue47) >= 40 and all(c.names for c in issue47)
     assert all(c.expect == RUN for c in RUNS)
     assert len({c.id for c in IN_PROCESS + RUNS + SUBPROCESS}) == len(IN_PROCESS) + len(RUNS) + len(SUBPROCESS)
 

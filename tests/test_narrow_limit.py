@@ -41,4 +41,4 @@ def test_a_slenderness_out_of_range_exits_2_with_one_line(capsys):
         N.main(["--slenderness", "5", "--out", "unused"])
     assert stop.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert err == "--slenderness 5 is outside [20, 1e5]"
+    assert err == "error: --slenderness 5 is outside [20, 1e5]"   # one line, as every command (ddg.cli_parser)

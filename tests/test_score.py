@@ -5,9 +5,14 @@ benchmark, the template filled in), malformed results refused with one line befo
 written, and `report --out FILE` refused the same way. Reads committed data only: no model is run."""
 from __future__ import annotations
 
+import contextlib
 import csv
 import importlib.util
 import math
+import os
+import signal
+import stat
+import time
 
 import numpy as np
 import pytest
@@ -279,8 +284,17 @@ MALFORMED = {
     "W/L 0": ([with_cell("width_ratio", "0")], "line 2, column width_ratio: 0 outside (0, 1)"),
     "dL/L 1.5": ([with_cell("compression_ratio", "1.5")], "line 2, column compression_ratio: 1.5 outside (0, 1)"),
     "dL/L -0.5": ([with_cell("compression_ratio", "-0.5")], "line 2, column compression_ratio: -0.5 outside"),
-    "L/b 0": ([with_cell("slenderness", "0")], "line 2, column slenderness: 0 must be > 0"),
-    "L/b negative": ([with_cell("slenderness", "-300")], "line 2, column slenderness: -300 must be > 0"),
+    "L/b 0": ([with_cell("slenderness", "0")], "line 2, column slenderness: 0 outside [10, 100000]"),
+    "L/b negative": ([with_cell("slenderness", "-300")], "line 2, column slenderness: -300 outside [10, 100000]"),
+    # issue 47 item 3: values near the float range went through to the figure (an IndexError in matplotlib)
+    "L/b 1e308": ([with_cell("slenderness", "1e308")], "line 2, column slenderness: 1e+308 outside [10, 100000]"),
+    "dW1 1e308": ([with_cell("dW1_over_L", "1e308")], "line 2, column dW1_over_L: 1e+308 outside [0, 1]"),
+    "dW2 1.5": ([with_cell("dW2_over_L", "1.5")], "line 2, column dW2_over_L: 1.5 outside [0, 1]"),
+    "dW negative": ([with_cell("dW1_over_L", "-0.1")], "line 2, column dW1_over_L: -0.1 outside [0, 1]"),
+    "H_mid 1e308": ([["H_mid", "0.5", "0.05", "1181.1", "0", "", "", "0.1", "1e308"]],
+                    "line 2, column H_mid_over_L: 1e+308 outside [-1, 1]"),
+    "H_mid point dW 2": ([["H_mid", "0.5", "0.05", "1181.1", "0", "", "", "2", "0.1"]],
+                         "line 2, column dW_over_L: 2 outside [0, 1]"),
     "nu 0.5": ([with_cell("poisson_ratio", "0.5")], "line 2, column poisson_ratio: 0.5 outside [0, 0.5)"),
     "nu negative": ([with_cell("poisson_ratio", "-0.1")], "line 2, column poisson_ratio: -0.1 outside [0, 0.5)"),
     "empty scene cell": ([with_cell("slenderness", "")], "line 2, column slenderness: empty"),
@@ -353,6 +367,64 @@ def test_a_results_directory_and_an_out_file_are_refused(tmp_path, capsys):
     check_refused(capsys, tmp_path, ["score", str(results), "--template", str(tmp_path / "t.csv")], "give one of")
     check_refused(capsys, tmp_path, ["score", "--template", str(tmp_path)], "is a directory")
     check_refused(capsys, tmp_path, ["score", "--benchmark", str(taken)], "--benchmark")
+
+
+@contextlib.contextmanager
+def at_most(seconds):
+    """SIGALRM after `seconds`: a read that blocks (a FIFO) fails the test instead of hanging it."""
+    def alarm(signum, frame):
+        raise TimeoutError(f"still running after {seconds} s")
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def test_a_fifo_a_device_and_a_huge_file_are_refused_before_they_are_read(tmp_path, capsys):
+    """Issue 47 item 3: a FIFO hung the read, /dev/zero read until MemoryError. RESULTS must be a
+    regular file of at most MAX_RESULTS_BYTES, checked (os.stat) before it is opened."""
+    from validation.score import MAX_RESULTS_BYTES
+
+    fifo = tmp_path / "results.fifo"
+    os.mkfifo(fifo)
+    with at_most(5):
+        check_refused(capsys, tmp_path, ["score", str(fifo), "--out", str(tmp_path / "score")],
+                      f"RESULTS {str(fifo)!r} is a FIFO, not a regular file")
+        check_refused(capsys, tmp_path, ["score", "/dev/zero", "--out", str(tmp_path / "score")],
+                      "RESULTS '/dev/zero' is a device, not a regular file")
+    huge = tmp_path / "huge.csv"
+    with open(huge, "wb") as fh:   # sparse: 9 MiB that take no disk
+        fh.truncate(MAX_RESULTS_BYTES + 2**20)
+    check_refused(capsys, tmp_path, ["score", str(huge), "--out", str(tmp_path / "score")],
+                  f"RESULTS {str(huge)!r} is 9.0 MiB; a results file may weigh at most 8 MiB")
+    assert MAX_RESULTS_BYTES >= 10 * len(write_csv(tmp_path / "all.csv", results_at(load_benchmark())).read_bytes())
+    assert not (tmp_path / "score").exists()
+
+
+def test_a_template_never_replaces_a_fifo_or_a_device(tmp_path, capsys):
+    """--template writes by an atomic rename onto its target: onto a FIFO (or /dev/null, as root) it would
+    replace the special file by a regular one. Refused in one line instead."""
+    fifo = tmp_path / "template.fifo"
+    os.mkfifo(fifo)
+    check_refused(capsys, tmp_path, ["score", "--template", str(fifo)], "exists and is not a regular file")
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)
+
+
+def test_a_long_curve_and_many_scenes_are_read_in_linear_time(tmp_path):
+    """Each row finds its scene and checks its dW/L against the curve in constant time (was a scan of
+    every scene and every point: minutes for a file well under MAX_RESULTS_BYTES)."""
+    curve = [["H_mid", "0.5", "0.05", "1181.1", "0", "", "", repr(i * 2e-5), "0.1"] for i in range(40000)]
+    scenes = [["thresholds", "0.5", repr(0.01 * 1.002**i), repr(lb), "0", "0.3", "0.4", "", ""]   # 0.2 % apart
+              for lb in (100.0, 200.0, 400.0, 800.0, 1600.0) for i in range(1000)]
+    results = write_csv(tmp_path / "results.csv", curve + scenes)
+    t0 = time.perf_counter()
+    read = read_results(results)
+    assert time.perf_counter() - t0 < 10.0
+    assert len(read) == 5001 and len(read[0].curve) == 40000 and read[1].width_ratio == 0.01
 
 
 def test_report_out_file_is_one_line(tmp_path, capsys, monkeypatch):

@@ -7,7 +7,9 @@ import sys
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m validation")
+    from ddg.cli_parser import OneLineParser  # one-line parse errors, exit 2
+
+    parser = OneLineParser(prog="python -m validation")
     sub = parser.add_subparsers(dest="command", required=True)
     rep = sub.add_parser("report", help="run the models on the paper's scenes and write DIR/index.html, report.md")
     group = rep.add_mutually_exclusive_group()
@@ -34,15 +36,13 @@ def main(argv=None) -> int:
         from .score import run
 
         return run(args)
-    if args.jobs < 1:
-        sys.stderr.write(f"error: --jobs = {args.jobs} must be >= 1\n")
-        return 2
     from ddg.geometry.strip import InputError
     from ddg.output.io import check_output_directory
 
     from .report import MissingExtra, build_report
 
     try:
+        check_report_inputs(args)
         check_output_directory(args.out, "--out")   # before any run: an existing file is one line, not a traceback
         summary = build_report(args.profile or "quick", args.out, jobs=args.jobs, progress=not args.quiet,
                                scheduler=args.scheduler)
@@ -52,6 +52,32 @@ def main(argv=None) -> int:
     print(f"report: {args.out}/index.html ({summary['runs']} runs, {summary['report_wall_time_s']:.0f} s); "
           f"claims failing: {summary['claims_failing'] or 'none'}")
     return 0
+
+
+def check_report_inputs(args) -> None:
+    """`report`'s options before any folder is made (a one-line ddg.InputError): --jobs within the
+    LocalCluster's bounds (ddg.sweep.cluster), DDG_BLAS_THREADS, and the scheduler the runs would use
+    (--scheduler, else DASK_SCHEDULER_ADDRESS) connected to once: an unreachable one leaves no --out.
+    Without dask the runs are made in this process (validation.runs.run_all says so), and no
+    scheduler is asked."""
+    from ddg.geometry.strip import InputError
+    from ddg.limits import check_integer
+    from ddg.solve.blas_threads import requested_threads
+    from ddg.sweep import cluster
+
+    check_integer("--jobs", args.jobs, 1, max(4 * cluster.cores(), 8),
+                  "worker processes for the runs; more than the cores share them")
+    requested_threads()
+    if args.scheduler is not None:
+        cluster.checked_options(args.scheduler, None, 0)
+    try:
+        cluster.require_dask()
+    except InputError:
+        return
+    if args.scheduler is not None:
+        cluster.check_scheduler(args.scheduler)
+    elif cluster.default_scheduler() is not None:
+        cluster.check_scheduler(cluster.default_scheduler(), "DASK_SCHEDULER_ADDRESS")
 
 
 if __name__ == "__main__":

@@ -21,13 +21,13 @@ data/benchmark`.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import time
 from fractions import Fraction
 from pathlib import Path
 
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, read_json_object, write_table_csv
 
 from .claims import threshold_agreement
@@ -266,7 +266,7 @@ def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
     from ddg.output.io import check_output_directory
 
-    parser = argparse.ArgumentParser(prog="python -m validation.benchmark", description=__doc__.split("\n")[0])
+    parser = OneLineParser(prog="python -m validation.benchmark", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/benchmark", help="output directory (default data/benchmark)")
     parser.add_argument("--no-rod", action="store_true",
                         help="run no 1D model (rod, ribbon-cross-section); use their stored files in OUT where "

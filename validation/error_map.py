@@ -42,10 +42,20 @@ existing cluster (its workers need the same ddg sources: the rows carry the clie
 Each worker returns its row, the client writes it to the table as the run ends; the stored runs'
 rows are made by the client. A worker killed mid-run costs that run, which is retried (--retries);
 --timeout is checked at each Newton solve. Ctrl-C keeps every row written (exit 130).
+
+A failed run is not a measurement, so the map never holds one: a run that ends in an error (it
+raised, or ran past --timeout: status "error"), or whose task failed, is reported on stderr with
+its reason and not written; the table keeps what it had for that key (an older row, not current, so
+the next run retries it), a row of status "error" read from an older table is dropped at the next
+write (its run retried too), and the command exits 1 after the README and the figures. So neither a
+bad --timeout nor a broken model can put failures into the committed map (the default --out,
+data/error_map). Every option is checked before any folder is made or any run starts (exit 2, one
+line): --only against the map's scenes, --models against the models the map has (the registry
+ddg.api.DEFAULT_RESOLUTION and the FEM), --timeout in [1, MAX_TIMEOUT] s, the cluster options, and
+a --scheduler connected to first.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import hashlib
 import json
@@ -59,6 +69,7 @@ import numpy as np
 
 from ddg.advise import (NOT_RUN, QUANTITIES, RULE_V1_MARGIN, at_scene, basis_scenes, choose, compared_at,
                         cross_validated_margin, fitting, map_scenes, measured_error, parse_rows, scene_name)
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import (StoredRun, atomic_write_text, finished_run_summary, finite_float, save_figure,
                           write_table_csv)
 from ddg.solve.probe import Probe
@@ -85,8 +96,12 @@ ROD_RESOLUTIONS = (50, 100, 200)
 RIBBON_RESOLUTIONS = (51, 101, 201)
 PLATE_MODELS = ("plate", "plate-midedge")
 CSV_NAME = "error_map.csv"
-#: Seconds one run made here may take before it is recorded as failed (a model that stalls).
+#: Seconds one run made here may take before it is stopped as failed (a model that stalls).
 RUN_TIMEOUT = 120
+#: Most seconds --timeout may give a run (a day: no run of the map's scenes needs a tenth of it).
+MAX_TIMEOUT = 86400
+#: The row status of a run that raised or ran out of time: never written to the table (module docstring).
+FAILED = "error"
 #: Tolerances of the README's tables and of the held-out check (units of L).
 TOLERANCES = (0.01, 0.02, 0.05)
 #: A reference curve that ends more than this short of dW_max/L gives no H_mid bound (units of L):
@@ -337,11 +352,12 @@ def _cell(value):
 
 
 class Table:
-    """OUT/error_map.csv, rewritten atomically after every row (rows of other keys kept)."""
+    """OUT/error_map.csv, rewritten atomically after every row (rows of other keys kept). Failed runs
+    (status FAILED) are never written: put refuses them, and those of an older table are dropped."""
 
     def __init__(self, path: Path):
         self.path = Path(path)
-        self.rows = read_table(self.path)
+        self.rows = [r for r in read_table(self.path) if r.get("status") != FAILED]
 
     def current(self, key: tuple, source_hash: str, reference_hash: str) -> bool:
         """A row of `key` made from this source, against this reference, under RULES_VERSION."""
@@ -356,10 +372,15 @@ class Table:
                     r["role"] = role
             write_table_csv(self.path, [{c: r.get(c, "") for c in COLUMNS} for r in self.rows], list(COLUMNS))
 
-    def put(self, row: dict) -> None:
+    def put(self, row: dict) -> bool:
+        """Write `row` in place of the row of its key; False, and nothing written, for a failed run
+        (status FAILED): the table keeps what it had for that key."""
+        if row.get("status") == FAILED:
+            return False
         row = {c: _cell(row.get(c)) for c in COLUMNS} | {"rules_version": RULES_VERSION}
         self.rows = [r for r in self.rows if _key(r) != _key(row)] + [row]
         write_table_csv(self.path, self.rows, list(COLUMNS))
+        return True
 
 
 def _base(scene: ReferenceScene, model: str, resolution: int, label: str) -> dict:
@@ -438,12 +459,14 @@ def stored_row(scene: ReferenceScene, mesh: StoredMesh) -> dict:
 
 
 def build(out: Path, only=None, models=None, quiet: bool = False, timeout: int = RUN_TIMEOUT, *,
-          scheduler: str | None = None, workers: int | None = None, retries: int = 2) -> list[dict]:
+          scheduler: str | None = None, workers: int | None = None, retries: int = 2,
+          failures: list | None = None) -> list[dict]:
     """Every row (module docstring) into OUT/error_map.csv, skipping current ones; the table's rows.
     The stored runs' rows are made here; the runs made here are Dask tasks (run_row on a worker,
     ddg.sweep.cluster.run_all: `scheduler`, else a LocalCluster of `workers` processes), each row
-    written as its run ends. Ctrl-C: the rows written are kept, the interrupt is raised with a
-    `run_message`."""
+    written as its run ends. A failed run is not written: one line on stderr, and its
+    "scene model label: reason" appended to `failures`. Ctrl-C: the rows written are kept, the
+    interrupt is raised with a `run_message`."""
     from ddg.output.interrupts import signal_name_of
     from ddg.sweep.cluster import Task, run_all
 
@@ -451,6 +474,12 @@ def build(out: Path, only=None, models=None, quiet: bool = False, timeout: int =
 
     table = Table(Path(out) / CSV_NAME)
     code = code_version()
+
+    def failed(what: str, why: str) -> None:
+        print(f"error: {what}: {why}; not written to the map (a rerun retries it)", file=sys.stderr, flush=True)
+        if failures is not None:
+            failures.append(f"{what}: {why}")
+
     family = rod_family()
     tasks = []
     for scene in reference_scenes():
@@ -469,7 +498,8 @@ def build(out: Path, only=None, models=None, quiet: bool = False, timeout: int =
                 continue
             row = stored_row(scene, mesh)
             row["source_hash"] = source
-            table.put(row)
+            if not table.put(row):
+                failed(f"{scene.name} {mesh.model} {mesh.label}", row.get("reason") or "the run failed")
         for model, resolutions in family:
             if models and model not in models:
                 continue
@@ -481,10 +511,12 @@ def build(out: Path, only=None, models=None, quiet: bool = False, timeout: int =
     def finished(task, row, error):
         scene, model, m, _ = task.args
         if error is not None:  # the task itself failed (its worker died at every attempt): no row, rerun next time
-            print(f"error: {scene.name} {model} M{m}: {error}", file=sys.stderr, flush=True)
+            failed(f"{scene.name} {model} M{m}", error)
             return
         row["source_hash"] = code
-        table.put(row)
+        if not table.put(row):   # the run raised or ran out of time: not a measurement
+            failed(f"{scene.name} {model} M{m}", row.get("reason") or "the run failed")
+            return
         if not quiet:
             print(f"{scene.name} {model} M{m}: {row.get('status')}, {row.get('wall_time_s') or 0:.1f} s, "
                   f"dW1 err {row.get('dW1_error')}, dW2 err {row.get('dW2_error')}, H_mid err "
@@ -862,47 +894,83 @@ def missing_scenes(scenes: list[ReferenceScene]) -> list[str]:
 
 def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
+    from ddg.limits import check_integer
     from ddg.output.interrupts import exit_code_of, terminate_as_interrupt
     from ddg.output.io import check_output_directory
+    from ddg.solve.blas_threads import requested_threads
     from ddg.sweep import cluster
 
-    parser = argparse.ArgumentParser(prog="python -m validation.error_map", description=__doc__.split("\n")[0])
+    parser = OneLineParser(prog="python -m validation.error_map", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/error_map", help="output directory (default data/error_map)")
     parser.add_argument("--only", nargs="+", default=None,
                         help="scenes to (re)compute, e.g. dL0.5_W0.05 or dL0.5_W0.05_Lb300 (default all)")
     parser.add_argument("--models", nargs="+", default=None, help="models to (re)compute (default all)")
-    parser.add_argument("--timeout", type=int, default=RUN_TIMEOUT, help="seconds per run made here")
+    parser.add_argument("--timeout", type=int, default=RUN_TIMEOUT,
+                        help=f"seconds per run made here, 1..{MAX_TIMEOUT} (default {RUN_TIMEOUT}); a run past it "
+                             "fails and is not written")
     parser.add_argument("--report-only", action="store_true", help="no runs: README and figures from the CSV")
     cluster.add_options(parser)  # --workers, --scheduler, --retries: the runs are Dask tasks, as the sweep's
     args = parser.parse_args(argv)
     terminate_as_interrupt()  # SIGTERM too keeps the rows written
-    try:
+    scenes = reference_scenes()
+    try:   # every option before any folder or run (module docstring); the scheduler connected to last
+        check_selection(args.only, args.models, scenes)
+        check_integer("--timeout", args.timeout, 1, MAX_TIMEOUT, "seconds one run made here may take")
         scheduler, workers, retries = cluster.checked_options(args.scheduler, args.workers, args.retries)
         if not args.report_only:
+            requested_threads()   # a bad DDG_BLAS_THREADS would fail every run on its worker
             scheduler = cluster.ready(scheduler, workers)
         out = check_output_directory(args.out, "--out")
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    scenes = reference_scenes()
+    failures: list[str] = []
     try:
         rows = read_table(out / CSV_NAME) if args.report_only else build(
-            out, args.only, args.models, timeout=args.timeout, scheduler=scheduler, workers=workers, retries=retries)
-    except InputError as exc:  # the scheduler at --scheduler does not answer
+            out, args.only, args.models, timeout=args.timeout, scheduler=scheduler, workers=workers, retries=retries,
+            failures=failures)
+    except InputError as exc:  # the scheduler at --scheduler went away after it was checked
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:
         print(f"error: {getattr(exc, 'run_message', 'interrupted')}", file=sys.stderr)
         return exit_code_of(exc)
     if not rows:
-        print("error: the map has no rows", file=sys.stderr)
-        return 3
+        print("error: the map has no rows" + (f" ({len(failures)} runs failed)" if failures else ""), file=sys.stderr)
+        return 1 if failures else 3
     held = {tol: held_out_check(rows, tol) for tol in TOLERANCES}
     names = figures(rows, out)
     atomic_write_text(out / "README.md", readme(rows, held, names, missing_scenes(scenes)))
     print(f"wrote {out / CSV_NAME} ({len(rows)} rows), {out / 'README.md'}"
           + "".join(f", {out / n}" for n in names))
+    if failures:
+        print(f"error: {len(failures)} run(s) failed and are not in the map (first: {failures[0]}); a rerun "
+              "retries them", file=sys.stderr)
+        return 1
     return 0
+
+
+def map_models() -> list[str]:
+    """The models the map has rows of: the rod's family in the registry (rod_family), the plates and
+    the FEM (their stored studies)."""
+    return list(dict.fromkeys([m for m, _ in rod_family()] + list(PLATE_MODELS) + ["fem"]))
+
+
+def check_selection(only, models, scenes: list[ReferenceScene]) -> None:
+    """--only names scenes of the map (each scene's name, e.g. dL0.5_W0.05_Lb1181, or its data folder's,
+    e.g. dL0.5_W0.05) and --models models it has (map_models); a one-line InputError naming the first
+    unknown value and the allowed ones otherwise."""
+    from ddg.geometry.strip import InputError
+
+    known = list(dict.fromkeys(n for s in scenes for n in (s.name, s.folder_name or gold_name(s.compression_ratio,
+                                                                                                 s.width_ratio))))
+    unknown = [n for n in (only or []) if n not in known]
+    if unknown:
+        raise InputError(f"--only {unknown[0]!r} is not a scene of the map; choose from {', '.join(known)}")
+    allowed = map_models()
+    unknown = [m for m in (models or []) if m not in allowed]
+    if unknown:
+        raise InputError(f"--models {unknown[0]!r} is not a model of the map; choose from {', '.join(allowed)}")
 
 
 if __name__ == "__main__":

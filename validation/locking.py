@@ -24,13 +24,13 @@ was run to dW/L = 0.26 (`python -m fem_reference simulate --width-ratio 0.166666
 """
 from __future__ import annotations
 
-import argparse
 import json
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, finished_run_summary
 
 WIDTH_RATIO, COMPRESSION_RATIO = 1 / 6, 0.5
@@ -145,7 +145,7 @@ def _fmt(value, spec="{:.4f}"):
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m validation.locking", description=__doc__.split("\n")[0])
+    parser = OneLineParser(prog="python -m validation.locking", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/midedge_locking")
     parser.add_argument("--fem", action="store_true", help="also the shell on 64 x 8 at each slenderness")
     parser.add_argument("--table-only", action="store_true", help="no run: rewrite the tables")

@@ -20,13 +20,13 @@ OUT/narrow_limit.md: dW1/L and dW2/L per model and mesh, with W^2/(b L). Resumab
 """
 from __future__ import annotations
 
-import argparse
 import json
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, finished_run_summary
 
 WIDTH_RATIO = 1 / 20
@@ -135,13 +135,13 @@ def write_table(out: Path, rows: list[dict]) -> None:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m validation.narrow_limit", description=__doc__.split("\n\n")[0])
+    parser = OneLineParser(prog="python -m validation.narrow_limit", description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default="data/narrow_limit")
     parser.add_argument("--slenderness", type=float, nargs="+", default=[PAPER_SLENDERNESS, 300.0, 100.0])
     args = parser.parse_args(argv)
     bad = [s for s in args.slenderness if not 20.0 <= s <= 1e5]
     if bad:
-        parser.exit(2, f"--slenderness {bad[0]:g} is outside [20, 1e5]\n")
+        parser.error(f"--slenderness {bad[0]:g} is outside [20, 1e5]")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     for s in args.slenderness:

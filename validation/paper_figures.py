@@ -20,7 +20,6 @@ The other paper figures' data come from the ddg command line (data/paper_figures
 """
 from __future__ import annotations
 
-import argparse
 import io
 import sys
 from pathlib import Path
@@ -103,7 +102,9 @@ def write_shapes(out: Path, **kw) -> list[Path]:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m validation.paper_figures", description=__doc__.splitlines()[0])
+    from ddg.cli_parser import OneLineParser  # one-line parse errors, exit 2
+
+    parser = OneLineParser(prog="python -m validation.paper_figures", description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="data/paper_figures")
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args(argv)

@@ -26,13 +26,13 @@ stopped short, 1 if one failed (one line each on stderr).
 """
 from __future__ import annotations
 
-import argparse
 import hashlib
 import json
 import sys
 import time
 from pathlib import Path
 
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, finished_run_summary, read_json_object
 
 from .estimates import DDG_TOLERANCES, load_study  # DDG_TOLERANCES: also read from here by benchmarks/
@@ -218,11 +218,12 @@ def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
     from ddg.output.interrupts import deferred_signals, exit_code_of, signal_name_of, terminate_as_interrupt
     from ddg.output.io import check_output_directory
+    from ddg.solve.blas_threads import requested_threads
     from ddg.sweep import cluster
     from ddg.sweep.grid import code_version
     from fem_reference.gold import all_scenes, scenes
 
-    parser = argparse.ArgumentParser(prog="python -m validation.plate_gold", description=__doc__.split("\n")[0])
+    parser = OneLineParser(prog="python -m validation.plate_gold", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/plate_gold")
     parser.add_argument("--only", nargs="*", default=None)
     parser.add_argument("--levels", type=int, default=LEVELS)
@@ -243,7 +244,8 @@ def main(argv=None) -> int:
             raise InputError(f"--levels = {args.levels} outside 1..4")
         scheduler, workers, retries = cluster.checked_options(args.scheduler, args.workers, args.retries)
         if not args.studies_only:
-            scheduler = cluster.ready(scheduler, workers)
+            requested_threads()   # a bad DDG_BLAS_THREADS would fail every run on its worker
+            scheduler = cluster.ready(scheduler, workers)   # connected to first: then --out is made
         out = check_output_directory(args.out, "--out")
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)

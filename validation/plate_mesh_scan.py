@@ -12,12 +12,12 @@ finished meshes are read back from the CSV.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import math
 import time
 from pathlib import Path
 
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, write_table_csv
 
 COMPRESSION_RATIO = 0.5
@@ -60,7 +60,7 @@ def run(width_ratio: float, target: int, equilateral: bool = False) -> dict:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m validation.plate_mesh_scan", description=__doc__.split("\n")[0])
+    parser = OneLineParser(prog="python -m validation.plate_mesh_scan", description=__doc__.split("\n")[0])
     parser.add_argument("--width-ratio", type=float, default=0.5)
     parser.add_argument("--triangles", type=int, nargs=2, default=[1200, 3400])
     parser.add_argument("--equilateral", action="store_true", help="exactly equilateral meshes of the same n_y")

@@ -21,12 +21,12 @@ order of |1 - ratio| over the whole width).
 """
 from __future__ import annotations
 
-import argparse
 import math
 from pathlib import Path
 
 import numpy as np
 
+from ddg.cli_parser import OneLineParser
 from ddg.energies.hinge_bending import hinge_bending_energy
 from ddg.geometry.strip import Strip
 from ddg.models.plate import PlateModel
@@ -207,7 +207,7 @@ def write(out: Path, rows: list[dict], orders: list[dict]) -> None:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m validation.plate_modes", description=__doc__.split("\n")[0])
+    parser = OneLineParser(prog="python -m validation.plate_modes", description=__doc__.split("\n")[0])
     parser.add_argument("--out", default="data/plate_modes")
     args = parser.parse_args(argv)
     rows, orders = study()

@@ -17,7 +17,6 @@ has TIMEOUT_S of wall time; one that needs more is reported with status "timeout
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import math
 import sys
@@ -133,7 +132,9 @@ def write_readme(out: Path, rows: list[dict]) -> None:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m validation.ribbon_regularisation")
+    from ddg.cli_parser import OneLineParser  # one-line parse errors, exit 2
+
+    parser = OneLineParser(prog="python -m validation.ribbon_regularisation")
     parser.add_argument("--out", default="data/ribbon_regularisation")
     args = parser.parse_args(argv)
     from ddg.geometry.strip import InputError

@@ -39,9 +39,13 @@ per scene, an empty cell where the code found no such threshold; its dW_over_L a
 stay empty. A row of kind "H_mid" gives one point (dW_over_L, H_mid_over_L) of the scene's H_mid curve
 (both required; dW1_over_L and dW2_over_L empty), any number of rows per scene, each dW/L once. Two
 rows are of one scene when their dL/L, W/L and L/b agree within MATCH_TOLERANCE (0.1 %) relative and
-their nu is equal. Every value a finite number; 0 < dL/L < 1, 0 < W/L < 1, L/b > 0, 0 <= nu < 0.5,
-dW/L >= 0. A malformed file is refused with one line naming its line and column, before anything is
-written (exit 2).
+their nu is equal. Every value a finite number in its physical range (RANGES): 0 < dL/L < 1,
+0 < W/L < 1, 10 <= L/b <= 1e5 (the strips ddg.Strip accepts), 0 <= nu < 0.5, 0 <= dW/L <= 1 (the
+clamps' shear never reaches L: dW_max/L < 1, Eq. B.1), -1 <= H_mid/L <= 1 (the midpoint lies L/2 of
+arclength from a clamp). RESULTS must be a regular file (not a FIFO or a device) of at most
+MAX_RESULTS_BYTES (8 MiB; the benchmark's own curves as a results file weigh 0.4 MB), checked before
+it is opened. A malformed file is refused with one line naming its line and column, before anything
+is written (exit 2).
 
 Scores (score.csv, score.md, score.png in --out, default out/score; a line per scene on stdout)
 ---------------------------------------------------------------------------------------------
@@ -65,14 +69,17 @@ from __future__ import annotations
 import csv
 import hashlib
 import io
+import itertools
 import math
+import os
+import stat
 import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from ddg.geometry.strip import InputError
+from ddg.geometry.strip import SLENDERNESS_RANGE, InputError
 from ddg.output.io import atomic_write_text, check_output_directory, save_figure, write_table_csv
 
 from .benchmark import basis_meshes, estimate_basis, fraction_label
@@ -95,6 +102,10 @@ BENCHMARK_VERSION = list(BENCHMARK_RELEASES)[-1]
 BENCHMARK_POISSON_RATIO = 0.0
 #: Relative tolerance on dL/L, W/L and L/b for a submitted row to be a benchmark scene (0.1 %).
 MATCH_TOLERANCE = 1e-3
+#: The largest RESULTS file read (bytes), checked before reading it. The benchmark's own H_mid curves
+#: written as a results file (3295 points of 28 scenes) weigh 0.4 MB; 8 MiB is 20 times that, and a
+#: bound on what is read into memory (/dev/zero, a runaway writer).
+MAX_RESULTS_BYTES = 8 * 2**20
 #: The least pointwise error bar of H_mid/L the scores divide by (units of L). The studies' bars below it
 #: are round-off, not discretisation error: past the snap (the S shape) H_mid is zero by symmetry, every
 #: FEM mesh gives it to 1e-14 L and the bar is 1e-15 L there, where a code's solver tolerance rather than
@@ -258,6 +269,8 @@ class SubmittedScene:
     dW1: float | None = None
     dW2: float | None = None
     curve: list[tuple[float, float, int]] = field(default_factory=list)
+    #: dW/L -> line of each point of `curve` (a repeated dW/L found without a scan of the curve)
+    point_lines: dict[float, int] = field(default_factory=dict, repr=False, compare=False)
 
     def same(self, compression_ratio, width_ratio, slenderness, poisson_ratio) -> bool:
         return poisson_ratio == self.poisson_ratio and _close(
@@ -271,25 +284,46 @@ class SubmittedScene:
         return {"dW1": self.dW1, "dW2": self.dW2}[key]
 
 
-#: The allowed range of each column: (test, the range in words).
+#: The allowed range of each column: (test, the range in words). Physical bounds, so that no value
+#: reaches the scores or the figure that the scene cannot have: L/b as ddg.Strip accepts it; the
+#: clamps' sideways shear dW at most L (dW_max/L < 1 for every W/L and dL/L, Eq. B.1); the midpoint
+#: no farther than L from the clamps' plane (it lies L/2 of arclength from a clamp: |H_mid| <= L/2
+#: for an inextensible strip; the bound leaves a code's own error room).
 RANGES = {"compression_ratio": (lambda x: 0 < x < 1, "outside (0, 1)"),
           "width_ratio": (lambda x: 0 < x < 1, "outside (0, 1)"),
-          "slenderness": (lambda x: x > 0, "must be > 0"),
+          "slenderness": (lambda x: SLENDERNESS_RANGE[0] <= x <= SLENDERNESS_RANGE[1],
+                          f"outside [{SLENDERNESS_RANGE[0]:g}, {SLENDERNESS_RANGE[1]:g}] (the strips ddg.Strip "
+                          "accepts)"),
           "poisson_ratio": (lambda x: 0 <= x < 0.5, "outside [0, 0.5)"),
-          **{c: (lambda x: x >= 0, "must be >= 0 (the magnitude of the clamps' sideways shear)")
+          **{c: (lambda x: 0 <= x <= 1, "outside [0, 1] (the magnitude of the clamps' sideways shear, at most "
+                                        "dW_max/L < 1, Eq. B.1)")
              for c in ("dW1_over_L", "dW2_over_L", "dW_over_L")},
-          "H_mid_over_L": (lambda x: True, "")}
+          "H_mid_over_L": (lambda x: -1 <= x <= 1, "outside [-1, 1] (the midpoint lies L/2 of arclength from a "
+                                                   "clamp)")}
 
 
 def _text_of(path: Path, name: str) -> str:
-    if not path.exists():
-        raise InputError(f"{name} {str(path)!r} does not exist")
-    if path.is_dir():
-        raise InputError(f"{name} {str(path)!r} is a directory, not a CSV file")
+    """The text of RESULTS, read only if it is a regular file of at most MAX_RESULTS_BYTES (os.stat
+    before any open or read: a FIFO would block the open, /dev/zero never ends); opened non-blocking and
+    checked again on the open file, so that a FIFO swapped in after the stat cannot block either."""
+    shown = repr(str(path))
     try:
-        data = path.read_bytes()
+        info = os.stat(path)
+    except FileNotFoundError:
+        raise InputError(f"{name} {shown} does not exist") from None
+    except (OSError, ValueError) as exc:   # a symlink loop, a name too long, a NUL byte
+        raise InputError(f"{name} {shown} cannot be read: {getattr(exc, 'strerror', None) or exc}") from None
+    _regular_and_small(info, name, shown)
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+        with os.fdopen(fd, "rb") as fh:
+            _regular_and_small(os.fstat(fh.fileno()), name, shown)
+            data = fh.read(MAX_RESULTS_BYTES + 1)
     except OSError as exc:
-        raise InputError(f"{name} {str(path)!r} cannot be read: {exc.strerror or exc}") from None
+        raise InputError(f"{name} {shown} cannot be read: {exc.strerror or exc}") from None
+    if len(data) > MAX_RESULTS_BYTES:   # it grew after the stat
+        raise InputError(f"{name} {shown} is larger than {MAX_RESULTS_BYTES // 2**20} MiB, the most a results file "
+                         "may weigh")
     if b"\0" in data:
         raise InputError(f"{name} {str(path)!r} is not a CSV file: it holds NUL bytes (binary data)")
     try:
@@ -297,6 +331,18 @@ def _text_of(path: Path, name: str) -> str:
     except UnicodeDecodeError as exc:
         line = data[:exc.start].count(b"\n") + 1
         raise InputError(f"{name} {str(path)!r} is not a CSV file: line {line} is not UTF-8 text") from None
+
+
+def _regular_and_small(info: os.stat_result, name: str, shown: str) -> None:
+    if stat.S_ISDIR(info.st_mode):
+        raise InputError(f"{name} {shown} is a directory, not a CSV file")
+    if not stat.S_ISREG(info.st_mode):
+        kind = ("a FIFO" if stat.S_ISFIFO(info.st_mode) else "a device" if stat.S_ISCHR(info.st_mode)
+                or stat.S_ISBLK(info.st_mode) else "a socket" if stat.S_ISSOCK(info.st_mode) else "not a file")
+        raise InputError(f"{name} {shown} is {kind}, not a regular file; give a CSV file")
+    if info.st_size > MAX_RESULTS_BYTES:
+        raise InputError(f"{name} {shown} is {info.st_size / 2**20:.1f} MiB; a results file may weigh at most "
+                         f"{MAX_RESULTS_BYTES // 2**20} MiB")
 
 
 def read_results(path, name: str = "RESULTS") -> list[SubmittedScene]:
@@ -310,6 +356,7 @@ def read_results(path, name: str = "RESULTS") -> list[SubmittedScene]:
     reader = csv.reader(lines)
     header = None
     scenes: list[SubmittedScene] = []
+    index: dict[tuple, list[SubmittedScene]] = {}
     try:
         for cells in reader:
             line = reader.line_num
@@ -320,7 +367,7 @@ def read_results(path, name: str = "RESULTS") -> list[SubmittedScene]:
                 continue
             if len(cells) != len(header):
                 raise InputError(f"{where} line {line}: {len(cells)} cells, the header has {len(header)} columns")
-            _add_row(scenes, dict(zip(header, (c.strip() for c in cells))), where, line)
+            _add_row(scenes, index, dict(zip(header, (c.strip() for c in cells))), where, line)
     except csv.Error as exc:
         raise InputError(f"{where} line {reader.line_num}: not CSV ({exc})") from None
     if header is None:
@@ -358,15 +405,34 @@ def _number(row: dict, column: str, where: str, line: int, required: bool) -> fl
     return value
 
 
-def _add_row(scenes: list[SubmittedScene], row: dict, where: str, line: int) -> None:
+#: The width of a cell of the scene index in log(dL/L), log(W/L), log(L/b): two values within
+#: MATCH_TOLERANCE relative lie in the same or neighbouring cells.
+_CELL = -math.log1p(-MATCH_TOLERANCE)
+
+
+def _cells(key: list[float]) -> tuple[int, ...]:
+    return tuple(math.floor(math.log(v) / _CELL) for v in key[:3])
+
+
+def _scene_of(index: dict, key: list[float]) -> SubmittedScene | None:
+    """The first scene (in file order) the row's dL/L, W/L, L/b, nu belong to (SubmittedScene.same),
+    looked up in the cells about the key: each row costs 27 look-ups, not a scan of every scene."""
+    cells, nu = _cells(key), key[3]
+    found = [s for shift in itertools.product((-1, 0, 1), repeat=3)
+             for s in index.get((nu,) + tuple(c + d for c, d in zip(cells, shift)), ()) if s.same(*key)]
+    return min(found, key=lambda s: s.line, default=None)
+
+
+def _add_row(scenes: list[SubmittedScene], index: dict, row: dict, where: str, line: int) -> None:
     kind = row.get("kind", "") or "thresholds"
     if kind not in KINDS:
         raise InputError(f"{where} line {line}, column kind: {kind!r} is not one of {', '.join(KINDS)}")
     key = [_number(row, c, where, line, True) for c in SCENE_COLUMNS]
-    scene = next((s for s in scenes if s.same(*key)), None)
+    scene = _scene_of(index, key)
     if scene is None:
         scene = SubmittedScene(*key, line)
         scenes.append(scene)
+        index.setdefault((key[3],) + _cells(key), []).append(scene)
     if kind == "thresholds":
         for column in CURVE_COLUMNS:
             if row.get(column, "") != "":
@@ -388,11 +454,12 @@ def _add_row(scenes: list[SubmittedScene], row: dict, where: str, line: int) -> 
             raise InputError(f"{where} line {line}, column {column}: an H_mid row leaves it empty (give the "
                              f"thresholds on the scene's thresholds row)")
     dw, h = (_number(row, c, where, line, True) for c in CURVE_COLUMNS)
-    earlier = next((p for p in scene.curve if p[0] == dw), None)
+    earlier = scene.point_lines.get(dw)
     if earlier is not None:
-        raise InputError(f"{where} line {line}, column dW_over_L: dW/L = {dw:g} is already on line {earlier[2]} "
+        raise InputError(f"{where} line {line}, column dW_over_L: dW/L = {dw:g} is already on line {earlier} "
                          f"of the scene's H_mid curve ({scene.describe()})")
     scene.curve.append((dw, h, line))
+    scene.point_lines[dw] = line
 
 
 # --- the scores ---------------------------------------------------------------------------------------
@@ -645,6 +712,9 @@ def run(args) -> int:
             target = Path(args.template)
             if target.is_dir():
                 raise InputError(f"--template = {args.template!r} is a directory; give a file name")
+            if target.exists() and not target.is_file():   # the template replaces its target (atomic rename)
+                raise InputError(f"--template = {args.template!r} exists and is not a regular file (a FIFO or "
+                                 "a device); give a file name")
             try:
                 target.parent.mkdir(parents=True, exist_ok=True)
                 write_template(target, scenes)

@@ -20,13 +20,13 @@ OUT/summary.json and OUT/wide_check.md hold the table.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
 
 import numpy as np
 
+from ddg.cli_parser import OneLineParser
 from ddg.output.io import StoredRun, atomic_write_text, finished_run_summary
 
 WIDTH_RATIO, COMPRESSION_RATIO = 1 / 2, 1 / 4
@@ -126,7 +126,7 @@ def write_tables(out: Path, fem_root: Path) -> dict:
 def main(argv=None) -> int:
     from ddg.geometry.strip import InputError
     from ddg.output.io import check_output_directory
-    parser = argparse.ArgumentParser(prog="python -m validation.wide_check", description=__doc__.split("\n\n")[0])
+    parser = OneLineParser(prog="python -m validation.wide_check", description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default="data/midedge_wide")
     parser.add_argument("--rows", type=int, nargs="+", default=list(ROWS))
     parser.add_argument("--membranes", nargs="+", default=list(MEMBRANES))

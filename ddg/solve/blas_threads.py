@@ -9,11 +9,11 @@ default threads, 18.0 s both idle and beside it with one thread.
 
 `blas_threads()` is the context every run executes in (ddg.protocol.driver.execute, so the
 command line, the API, sweeps and the report alike): the BLAS libraries this process has loaded
-run with DDG_BLAS_THREADS threads (default 1; "keep" leaves them as they are), and get their
-previous setting back when the run ends, so a program that calls ddg keeps its own. It acts on
-the libraries threadpoolctl controls, if that package is installed, else on an OpenBLAS found
-among the process's loaded libraries (Linux: /proc/self/maps; Debian's libopenblas0-pthread);
-where neither applies it does nothing and says so in `describe()`.
+run with DDG_BLAS_THREADS threads (default 1, at most MAX_THREADS = 256; "keep" leaves them as they
+are), and get their previous setting back when the run ends, so a program that calls ddg keeps its
+own. It acts on the libraries threadpoolctl controls, if that package is installed, else on an
+OpenBLAS found among the process's loaded libraries (Linux: /proc/self/maps; Debian's
+libopenblas0-pthread); where neither applies it does nothing and says so in `describe()`.
 """
 from __future__ import annotations
 
@@ -26,13 +26,18 @@ from ..geometry.strip import InputError
 
 __all__ = ["blas_threads", "requested_threads", "describe"]
 
-#: Environment variable: the BLAS threads of a run (a positive integer, or "keep").
+#: Environment variable: the BLAS threads of a run (an integer in 1..MAX_THREADS, or "keep").
 ENVIRONMENT = "DDG_BLAS_THREADS"
+#: Most BLAS threads a run may ask for: above the cores of any machine this runs on (OpenBLAS's own
+#: builds stop at their compile-time NUM_THREADS, 64 to 512), so a larger value is a typo, not a
+#: choice; each thread is a pthread with its own buffers, and 1e9 of them is no run at all.
+MAX_THREADS = 256
 
 
 def requested_threads() -> int | None:
-    """The threads DDG_BLAS_THREADS asks for: 1 by default, None for "keep"; a one-line error
-    naming the value otherwise."""
+    """The threads DDG_BLAS_THREADS asks for: 1 by default, None for "keep"; a one-line InputError
+    naming the value and the allowed range otherwise (the command lines call this before any work,
+    exit 2)."""
     value = os.environ.get(ENVIRONMENT, "1").strip()
     if value.lower() == "keep":
         return None
@@ -40,8 +45,9 @@ def requested_threads() -> int | None:
         threads = int(value)
     except ValueError:
         threads = 0
-    if threads < 1:
-        raise InputError(f"{ENVIRONMENT} = {value!r} must be a positive integer or 'keep'")
+    if not 1 <= threads <= MAX_THREADS:
+        shown = repr(value) if len(value) <= 40 else repr(value[:40]) + "..."
+        raise InputError(f"{ENVIRONMENT} = {shown} must be an integer in [1, {MAX_THREADS}] or 'keep'")
     return threads
 
 

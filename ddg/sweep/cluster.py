@@ -69,11 +69,7 @@ def connect(scheduler: str | None = None, workers: int | None = None, retries: i
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
-        try:
-            client = Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s")
-        except Exception as exc:  # noqa: BLE001  (OSError, TimeoutError, ValueError for a malformed address)
-            raise InputError(f"--scheduler {scheduler!r}: cannot connect within {CONNECT_TIMEOUT_S} s: "
-                             f"{' '.join(str(exc).split()) or type(exc).__name__}") from None
+        client = _client(scheduler, "--scheduler")
         try:
             yield client
         finally:
@@ -94,6 +90,48 @@ def connect(scheduler: str | None = None, workers: int | None = None, retries: i
             client.close()
     finally:
         cluster.close()
+
+
+def _cannot_connect(scheduler: str, name: str, reason) -> InputError:
+    text = " ".join(str(reason).split()) or type(reason).__name__
+    return InputError(f"{name} {scheduler!r}: cannot connect within {CONNECT_TIMEOUT_S} s: {text}; give the "
+                      "address of a running dask scheduler, e.g. tcp://host:8786")
+
+
+def _client(scheduler: str, name: str, **options):
+    """A Client on the scheduler at `scheduler`, or the one-line InputError naming it (`name`: the
+    option or setting it came from)."""
+    from distributed import Client
+
+    try:
+        return Client(scheduler, timeout=f"{CONNECT_TIMEOUT_S}s", **options)
+    except Exception as exc:  # noqa: BLE001  (OSError, TimeoutError, ValueError for a malformed address)
+        raise _cannot_connect(scheduler, name, exc) from None
+
+
+def check_scheduler(scheduler: str, name: str = "--scheduler") -> None:
+    """A scheduler answers at `scheduler`: connect, then close again; a one-line InputError naming the
+    address otherwise. A TCP address is first tried with a bare socket, so that a port where nothing
+    listens (connection refused) or a host that does not exist is refused at once instead of after
+    Dask's CONNECT_TIMEOUT_S of retries. The commands call it (ready) before they create any folder:
+    connect first, then mkdir, so an unreachable scheduler leaves nothing behind. It costs one
+    connection more than the runs need (some tens of milliseconds on a live scheduler)."""
+    require_dask()
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        protocol, location = parse_address(scheduler)
+        host, port = parse_host_port(location) if protocol in ("tcp", "tls") else (None, None)
+    except ValueError:   # no port, or a scheme Dask resolves itself (inproc, ucx): its Client decides
+        host, port = None, None
+    if port is not None:
+        if not 1 <= port <= 65535:
+            raise _cannot_connect(scheduler, name, f"port {port} outside [1, 65535]")
+        try:
+            socket.create_connection((host, port), timeout=CONNECT_TIMEOUT_S).close()
+        except OSError as exc:   # refused, unknown host, unreachable network, timed out
+            raise _cannot_connect(scheduler, name, exc.strerror or exc) from None
+    _client(scheduler, name, set_as_default=False).close()
 
 
 def describe(client) -> str:
@@ -280,12 +318,17 @@ def checked_options(scheduler, workers, retries) -> tuple[str | None, int | None
     return scheduler, workers, retries
 
 
-def ready(scheduler: str | None, workers: int | None) -> str | None:
+def ready(scheduler: str | None, workers: int | None, check: bool = True) -> str | None:
     """require_dask(), then the scheduler to use: `scheduler`, else Dask's own setting
-    (DASK_SCHEDULER_ADDRESS) unless --workers asked for a LocalCluster, else None (a LocalCluster)."""
+    (DASK_SCHEDULER_ADDRESS) unless --workers asked for a LocalCluster, else None (a LocalCluster).
+    With `check` (the default) a scheduler is connected to once (check_scheduler): the commands call
+    this before they create their output folder."""
     require_dask()
+    name = "--scheduler"
     if scheduler is None and workers is None:
-        return default_scheduler()
+        scheduler, name = default_scheduler(), "DASK_SCHEDULER_ADDRESS"
+    if scheduler is not None and check:
+        check_scheduler(scheduler, name)
     return scheduler
 
 

@@ -10,7 +10,8 @@ table. `python -m ddg sweep` (ddg.sweep.command) is this function behind a parse
         result.rows[0]["dW1_over_L"], result.complete, result.files
 
 Every value is checked before any work (InputError naming the value and its allowed range); a
-missing dask install or an unreachable scheduler is an InputError too. Each run is cached in
+missing dask install or an unreachable scheduler is an InputError too, raised before the output
+folder is created (the scheduler is connected to first). Each run is cached in
 DIR/runs/<key>/ by a hash of its inputs and of the ddg sources, so a second call computes only what
 is missing. Ctrl-C tables the finished runs, then raises KeyboardInterrupt.
 """
@@ -93,6 +94,7 @@ def sweep(models, width_ratios, compression_ratios, slendernesses=None, resoluti
     `names` maps each argument to the name its errors use (the command line's option names)."""
     from ..output.interrupts import deferred_signals
     from ..output.io import check_output_directory
+    from ..solve.blas_threads import requested_threads
     from . import cluster
     from .cache import run_cached
     from .grid import grid
@@ -106,7 +108,8 @@ def sweep(models, width_ratios, compression_ratios, slendernesses=None, resoluti
                  [None] if resolutions is None else checked_integers(n["resolutions"], resolutions),
                  compression_steps, shear_steps)
     scheduler, workers, retries = cluster.checked_options(scheduler, workers, retries)
-    scheduler = cluster.ready(scheduler, workers)
+    requested_threads()   # a bad DDG_BLAS_THREADS would fail every run on its worker
+    scheduler = cluster.ready(scheduler, workers)   # connected to once: an unreachable one leaves no folder
     out = check_output_directory(out, n["out"])
 
     outcome = run_cached(specs, out / "runs", workers=workers, scheduler=scheduler, retries=retries,

@@ -45,7 +45,10 @@ def stencil_stretch_values(x: np.ndarray, rest_edge_lengths: np.ndarray) -> np.n
             d = x[j + 1, k] - x[j, k]
             total += d * d
         lengths[j] = np.sqrt(total)
-    return (lengths[:-1] + lengths[1:]) / (rest_edge_lengths[:-1] + rest_edge_lengths[1:]) - 1.0
+    eps = np.empty(x.shape[0] - 2)
+    for i in range(eps.shape[0]):
+        eps[i] = (lengths[i] + lengths[i + 1]) / (rest_edge_lengths[i] + rest_edge_lengths[i + 1]) - 1.0
+    return eps
 
 
 def stencil_stretch(x: np.ndarray, rest_edge_lengths: np.ndarray):

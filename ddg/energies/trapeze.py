@@ -38,15 +38,18 @@ def trapeze_density(eps, tau, voronoi_lengths, coupling, quartic):
 
     eps: the stencils' centreline stretch; tau: their integrated twist (Eq. 5); coupling, quartic:
     C3, C5 of trapeze_coefficients. Compiled (the one-call assembly, ddg.models.rod_assembly, calls it)."""
-    dl = voronoi_lengths
-    t2 = tau * tau
-    energy = coupling * eps * t2 / dl + quartic * t2 * t2 / dl**3
-    first = np.empty((energy.shape[0], 2))
-    first[:, 0] = coupling * t2 / dl
-    first[:, 1] = 2.0 * coupling * eps * tau / dl + 4.0 * quartic * tau * t2 / dl**3
-    second = np.empty((energy.shape[0], 2, 2))
-    second[:, 0, 0] = 0.0
-    second[:, 0, 1] = 2.0 * coupling * tau / dl
-    second[:, 1, 0] = 2.0 * coupling * tau / dl
-    second[:, 1, 1] = 2.0 * coupling * eps / dl + 12.0 * quartic * t2 / dl**3
+    n = eps.shape[0]
+    energy = np.empty(n)
+    first = np.empty((n, 2))
+    second = np.empty((n, 2, 2))
+    for i in range(n):
+        dl, t, e = voronoi_lengths[i], tau[i], eps[i]
+        t2 = t * t
+        dl3 = dl * dl * dl
+        energy[i] = coupling * e * t2 / dl + quartic * t2 * t2 / dl3
+        first[i, 0] = coupling * t2 / dl
+        first[i, 1] = 2.0 * coupling * e * t / dl + 4.0 * quartic * t * t2 / dl3
+        second[i, 0, 0] = 0.0
+        second[i, 0, 1] = second[i, 1, 0] = 2.0 * coupling * t / dl
+        second[i, 1, 1] = 2.0 * coupling * e / dl + 12.0 * quartic * t2 / dl3
     return energy, first, second

@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .sadowsky import quartic_twist_term
+from .sadowsky import quartic
 
 #: Below this |v| the ruling factor and its derivatives are summed as series (to v^12), which is
 #: exact to round-off there; above it the closed forms lose at most ~1e-13 to cancellation.
@@ -87,28 +87,23 @@ def ruling_factor(v):
 
 @njit(cache=True)
 def ruling_slope(kappa_n, tau, regularisation):
-    """eta = tau k / (k^2 + r^2) and its partials (eta_k, eta_t, eta_kk, eta_kt, eta_tt)."""
-    d = kappa_n**2 + regularisation**2
-    r2_minus_k2 = regularisation**2 - kappa_n**2
-    eta = tau * kappa_n / d
-    eta_k = tau * r2_minus_k2 / d**2
-    eta_t = kappa_n / d
-    eta_kk = -2.0 * kappa_n * tau * (3.0 * regularisation**2 - kappa_n**2) / d**3
-    eta_kt = r2_minus_k2 / d**2
-    eta_tt = np.zeros_like(eta)
-    return eta, eta_k, eta_t, eta_kk, eta_kt, eta_tt
+    """eta = tau k / (k^2 + r^2) and its partials (eta_k, eta_t, eta_kk, eta_kt, eta_tt) at one stencil."""
+    r2 = regularisation * regularisation
+    d = kappa_n * kappa_n + r2
+    r2_minus_k2 = r2 - kappa_n * kappa_n
+    return (tau * kappa_n / d, tau * r2_minus_k2 / (d * d), kappa_n / d,
+            -2.0 * kappa_n * tau * (3.0 * r2 - kappa_n * kappa_n) / (d * d * d), r2_minus_k2 / (d * d), 0.0)
 
 
 @njit(cache=True)
-def sadowsky_part(kappa_n, tau, voronoi_lengths, bending_stiffness, twisting_stiffness, regularisation):
-    """S = (EI2 k^2 + GJ tau^2 + EI2 tau^4 / (k^2 + r^2)) / (2 dl) per stencil and its partials
+def sadowsky_part(kappa_n, tau, voronoi_length, bending_stiffness, twisting_stiffness, regularisation):
+    """S = (EI2 k^2 + GJ tau^2 + EI2 tau^4 / (k^2 + r^2)) / (2 dl) at one stencil and its partials
     (S_k, S_t, S_kk, S_kt, S_tt): the out-of-plane and twist part of Eq. (A.5)."""
-    half = 0.5 / voronoi_lengths
-    q, q_k, q_t, q_kk, q_kt, q_tt = quartic_twist_term(kappa_n, tau, regularisation)
+    half = 0.5 / voronoi_length
+    q, q_k, q_t, q_kk, q_kt, q_tt = quartic(kappa_n, tau, regularisation)
     b, t = bending_stiffness, twisting_stiffness
-    s = half * (b * kappa_n**2 + t * tau**2 + b * q)
-    return (s, half * (2.0 * b * kappa_n + b * q_k), half * (2.0 * t * tau + b * q_t),
-            half * (2.0 * b + b * q_kk), half * b * q_kt, half * (2.0 * t + b * q_tt))
+    return (half * (b * kappa_n * kappa_n + t * tau * tau + b * q), half * (2.0 * b * kappa_n + b * q_k),
+            half * (2.0 * t * tau + b * q_t), half * (2.0 * b + b * q_kk), half * b * q_kt, half * (2.0 * t + b * q_tt))
 
 
 @njit(cache=True)
@@ -132,9 +127,14 @@ def wunderlich_pair_density(kappa_n, tau, voronoi_lengths, pair_lengths, width, 
 
     kappa_n, tau: the stencils' integrated strains; regularisation r = dl / zeta per stencil;
     pair_lengths h: the rest distance between the two nodes (the rest edge length)."""
-    s, s_k, s_t, s_kk, s_kt, s_tt = sadowsky_part(kappa_n, tau, voronoi_lengths, bending_stiffness,
-                                                  twisting_stiffness, regularisation)
-    eta, e_k, e_t, e_kk, e_kt, e_tt = ruling_slope(kappa_n, tau, regularisation)
+    n = kappa_n.shape[0]
+    w = np.empty((12, n))
+    s, s_k, s_t, s_kk, s_kt, s_tt = w[0], w[1], w[2], w[3], w[4], w[5]
+    eta, e_k, e_t, e_kk, e_kt, e_tt = w[6], w[7], w[8], w[9], w[10], w[11]
+    for i in range(n):
+        s[i], s_k[i], s_t[i], s_kk[i], s_kt[i], s_tt[i] = sadowsky_part(
+            kappa_n[i], tau[i], voronoi_lengths[i], bending_stiffness, twisting_stiffness, regularisation[i])
+        eta[i], e_k[i], e_t[i], e_kk[i], e_kt[i], e_tt[i] = ruling_slope(kappa_n[i], tau[i], regularisation[i])
     a, b = pair_weights(kappa_n.shape[0])
     m = kappa_n.shape[0] - 1
     energy = np.empty(m)

@@ -85,8 +85,11 @@ def _with_stretch(first, second):
     n = first.shape[0]
     f = np.zeros((n, 4))
     s = np.zeros((n, 4, 4))
-    f[:, 1:] = first
-    s[:, 1:, 1:] = second
+    for i in range(n):
+        for a in range(3):
+            f[i, 1 + a] = first[i, a]
+            for b in range(3):
+                s[i, 1 + a, 1 + b] = second[i, a, b]
     return f, s
 
 
@@ -98,12 +101,11 @@ def _trapeze(x, tau, first, second, rest_lengths, voronoi, reals, node_stride, n
     parts[4] = energy.sum()
     if want_gradient:
         f, s = _with_stretch(first, second)
-        f[:, 0] += f_t[:, 0]
-        f[:, 3] += f_t[:, 1]
-        s[:, 0, 0] += s_t[:, 0, 0]
-        s[:, 0, 3] += s_t[:, 0, 1]
-        s[:, 3, 0] += s_t[:, 1, 0]
-        s[:, 3, 3] += s_t[:, 1, 1]
+        for i in range(f.shape[0]):   # (eps, tau) sit at (0, 3) of (eps, kappa_n, kappa_g, tau)
+            for a in range(2):
+                f[i, 3 * a] += f_t[i, a]
+                for b in range(2):
+                    s[i, 3 * a, 3 * b] += s_t[i, a, b]
         add_stretched_stencil_terms(x, m1, m2, rest_lengths, f, s, node_stride, np.zeros(0, np.int64), n_dof, grad,
                                     band, want_hessian, np.empty((0, 4, STENCIL_SIZE)))
 
@@ -164,8 +166,11 @@ def _cross_section(q, x, kappa_n, kappa_g, tau, first, second, rest_lengths, vor
     if not want_gradient:
         return
     # u = (eps, kappa_n, kappa_g, tau, modes): the rod's own partials and Eq. V's per-twist parts join Eq. X's
-    f_u[:, 1:4] += first
-    f_uu[:, 1:4, 1:4] += second
+    for i in range(count):
+        for a in range(3):
+            f_u[i, 1 + a] += first[i, a]
+            for b in range(3):
+                f_uu[i, 1 + a, 1 + b] += second[i, a, b]
     add_torsion_warping_partials(f_u, f_uu, pf, ps, ef, es)
     gradients = np.empty((count if want_hessian else 0, 4, STENCIL_SIZE))
     add_stretched_stencil_terms(x, m1, m2, rest_lengths, f_u, f_uu, node_stride, unit_place, n_dof, grad, band,

@@ -143,10 +143,18 @@ def _worker(part: str) -> tuple[str, float]:
     return part, compile_part(part)
 
 
+#: The parts whose kernels are the same (the rod's kind of width terms): warmed in one process, in order.
+SAME_KERNELS = ("rod", "ribbon", "ribbon-sano-wada")
+#: The order in which parts are handed to the workers: the longest first (benchmarks/compile_time.py).
+LONGEST_FIRST = ("ribbon-cross-section", "rod", "ribbon-wunderlich", "ribbon-trapeze", "plate-midedge", "plate",
+                 "arrays")
+
+
 def compile_in_parallel(parts=None, jobs: int | None = None) -> dict:
-    """compile_kernels over `jobs` worker processes (spawned: each has its own numba). The parts
-    that share kernels go to one worker in order (the rod family's compiled energy and solvers are
-    compiled once by the first rod-family part, then loaded from the cache by the others)."""
+    """compile_kernels over `jobs` worker processes (spawned: each has its own numba), the longest
+    parts first. The parts that compile the same kernels go to one worker in order (the rod's, then
+    the ribbons that share its compiled energy and solvers, which load them from the cache);
+    other parts share only small kernels, which two workers may both compile."""
     parts = list(PARTS if parts is None else parts)
     jobs = max(1, min(jobs or min(os.cpu_count() or 1, 4), len(parts)))
     if jobs == 1:
@@ -154,12 +162,14 @@ def compile_in_parallel(parts=None, jobs: int | None = None) -> dict:
     import concurrent.futures as cf
     import multiprocessing as mp
 
-    family = [p for p in parts if p in ROD_FAMILY]
-    queues = [family] if family else []
-    queues += [[p] for p in parts if p not in ROD_FAMILY]
+    same = [p for p in SAME_KERNELS if p in parts]
+    queues = {p: [p] for p in parts if p not in SAME_KERNELS}
+    if same:
+        queues["rod"] = same
+    order = sorted(queues, key=lambda p: LONGEST_FIRST.index(p) if p in LONGEST_FIRST else len(LONGEST_FIRST))
     timings = {}
     with cf.ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:
-        for done in pool.map(compile_kernels, queues):
+        for done in pool.map(compile_kernels, [queues[p] for p in order]):
             timings.update(done)
     return {p: timings[p] for p in parts}
 

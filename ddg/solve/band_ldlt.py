@@ -131,6 +131,17 @@ def _update(t, j0, j1, c0, c1, chunk):
 
 
 @njit(cache=True)
+def ldlt_unblocked(t, tol):
+    """ldlt_transposed without the blocked path (column by column, whatever the bandwidth): the same
+    factors, for callers whose bands are narrow (below BLOCKED_FROM, where ldlt_transposed takes
+    this path too) and whose compile should not carry the blocked update's matrix products (the
+    rod family's compiled Newton loop, ddg.solve.compiled_newton). Returns as ldlt_transposed."""
+    state = np.array([0, -1, -1])
+    _columns(t, 0, t.shape[0], tol, state)
+    return state[0], state[1], state[2]
+
+
+@njit(cache=True)
 def ldlt_transposed(t, tol, panel, leaf, chunk, blocked_from):
     """In place on t (n, w), t[j, r] = A[j + r, j]: on return t[j, r] = L[j + r, j] for r >= 1 and
     t[j, 0] = d_j. Returns (number of pivots with |d| <= tol, first such column or -1, column of an

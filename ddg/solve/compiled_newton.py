@@ -24,7 +24,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .band_ldlt import BLOCKED_FROM, CHUNK, LEAF, PANEL, ldlt_transposed, solve_transposed_1
+from .band_ldlt import ldlt_unblocked, solve_transposed_1
 from .band_scatter import band_matvec
 from .banded import SymmetricBanded
 from ..models.rod_assembly import ENERGIES, KIND_NAMES, ROD, kind_of
@@ -68,9 +68,7 @@ def _solve_indefinite(t, rhs):
     f = t.copy()
     first_tiny = -1
     if m:
-        # the block sizes as runtime ints: numba compiles a separate specialisation for literal arguments
-        sizes = np.array((PANEL, LEAF, CHUNK, BLOCKED_FROM))
-        _, first_tiny, _ = ldlt_transposed(f, tolerance, sizes[0], sizes[1], sizes[2], sizes[3])
+        _, first_tiny, _ = ldlt_unblocked(f, tolerance)
     x = np.empty_like(rhs)
     if first_tiny < 0:
         band = np.ascontiguousarray(t.T)

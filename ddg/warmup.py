@@ -20,8 +20,8 @@ import time
 
 import numpy as np
 
-#: Rod-family parts share one compiled energy (ddg.models.rod_assembly.rod_energy) per kind of
-#: width terms; the plates share nothing with them.
+#: The rod family's parts: their compiled energy and loops are compiled per kind of width terms
+#: (ddg.models.rod_assembly.ENERGIES); the plates share nothing with them.
 ROD_FAMILY = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section", "ribbon-wunderlich")
 PLATES = ("plate", "plate-midedge")
 PARTS = ROD_FAMILY + PLATES + ("arrays",)

@@ -9,8 +9,9 @@ chain rule (ddg.energies.rod_curvature.add_stencil_terms); no physics is written
 instead of a dozen saves the interpreter's ~30 microseconds per evaluation, and it is what the
 compiled Newton loop (ddg.solve.compiled_newton) calls.
 
-The ribbons with width add their terms in the same call, chosen by `args`'s last entry (the width
-terms, `width_terms`; kind ROD adds nothing): the trapeze term's stretch-twist coupling
+The ribbons with width add their terms in the same call, chosen by the kind in `args`'s last entry
+(the width terms, `width_terms`; kind ROD adds nothing) and compiled apart per kind (ENERGIES, by
+ddg.solve.specialise: a model compiles only its own terms): the trapeze term's stretch-twist coupling
 (ddg.energies.trapeze) on the stencils' chain rule with the stretch (rod_curvature.
 add_stretched_stencil_terms), Wunderlich's pairs of stencils (ddg.energies.wunderlich, their cross
 terms by rod_curvature.add_pair_cross_terms), and the cross-section as a field (ddg.energies.
@@ -52,8 +53,8 @@ PARTS = ("stretching", "bending", "twisting", "sadowsky", "trapeze", "wunderlich
 #: The kinds of width terms (the first entry of `width_terms`).
 ROD, TRAPEZE, WUNDERLICH, CROSS_SECTION = range(4)
 
-#: How many vectors, matrices and index arrays the width terms carry (one layout for every kind,
-#: so that the compiled Newton loop is compiled once for all the models).
+#: How many vectors, matrices and index arrays the width terms carry (one layout for every kind:
+#: the same argument types for every kind's compiled energy and loops).
 _VECTORS, _MATRICES, _INDICES = 5, 5, 3
 
 

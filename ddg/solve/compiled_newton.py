@@ -56,6 +56,41 @@ def _free_block(band, n, start, stop):
 
 
 @njit(cache=True)
+def _column(matrix, c):
+    """Column c of a 2-D array as a new contiguous vector (a loop: numpy's strided copy and array
+    expressions compile to many times the code in every loop that links this module's helpers)."""
+    out = np.empty(matrix.shape[0])
+    for i in range(matrix.shape[0]):
+        out[i] = matrix[i, c]
+    return out
+
+
+@njit(cache=True)
+def _norm(v):
+    total = 0.0
+    for i in range(v.shape[0]):
+        total += v[i] * v[i]
+    return math.sqrt(total)
+
+
+@njit(cache=True)
+def _residual_norm(t, x, b):
+    """|A x - b| for the symmetric A of the transposed lower band t (m, w), t[j, d] = A[j + d, j]."""
+    m, w = t.shape
+    r = np.empty(m)
+    for j in range(m):
+        r[j] = t[j, 0] * x[j]
+    for d in range(1, w):
+        for j in range(m - d):
+            v = t[j, d]
+            r[j + d] += v * x[j]
+            r[j] += v * x[j + d]
+    for j in range(m):
+        r[j] -= b[j]
+    return _norm(r)
+
+
+@njit(cache=True)
 def _solve_indefinite(t, rhs):
     """SymmetricBanded.solve where the Cholesky failed, for the columns of rhs (m, k): LDL^T kept
     if every column's residual is below LDLT_RESIDUAL, else banded LU. Returns (x, ok)."""
@@ -71,26 +106,23 @@ def _solve_indefinite(t, rhs):
         _, first_tiny, _ = ldlt_unblocked(f, tolerance)
     x = np.empty_like(rhs)
     if first_tiny < 0:
-        band = np.ascontiguousarray(t.T)
         good = True
         for c in range(rhs.shape[1]):
-            b = np.ascontiguousarray(rhs[:, c])
+            b = _column(rhs, c)
             xc = solve_transposed_1(f, b.copy())
-            if not _all_finite(xc):
+            if not _all_finite(xc) or _residual_norm(t, xc, b) > LDLT_RESIDUAL * _norm(b):
                 good = False
                 break
-            r = band_matvec(band, xc) - b
-            if math.sqrt(np.dot(r, r)) > LDLT_RESIDUAL * math.sqrt(np.dot(b, b)):
-                good = False
-                break
-            x[:, c] = xc
+            for i in range(m):
+                x[i, c] = xc[i]
         if good:
             return x, True
     for c in range(rhs.shape[1]):
-        xc, ok = band_lu_solve(t, np.ascontiguousarray(rhs[:, c]))
+        xc, ok = band_lu_solve(t, _column(rhs, c))
         if not ok:
             return x, False
-        x[:, c] = xc
+        for i in range(m):
+            x[i, c] = xc[i]
     return x, True
 
 
@@ -103,9 +135,10 @@ def _factor_and_solve(t, rhs):
     if pd:
         x = np.empty_like(rhs)
         for c in range(rhs.shape[1]):
-            xc = np.ascontiguousarray(rhs[:, c])
+            xc = _column(rhs, c)
             band_cholesky_solve(factor, xc)
-            x[:, c] = xc
+            for i in range(xc.shape[0]):
+                x[i, c] = xc[i]
         return x, True, True, factor
     x, ok = _solve_indefinite(t, rhs)
     return x, ok, False, np.empty((0, 0))
@@ -251,8 +284,11 @@ def _newton_load_step(args, q, state, energy0, parts0, grad0, band0, start, stop
 
 @njit(cache=True)
 def _inner(weight2, a_q, a_w, b_q, b_w, length):
-    """ArclengthTracer.inner: (1/n) sum a_i b_i / l_i^2 + a_w b_w / L^2."""
-    return np.sum(weight2 * a_q * b_q) + a_w * b_w / length**2
+    """ArclengthTracer.inner: (1/n) sum a_i b_i / l_i^2 + a_w b_w / L^2 (weight2 = 1 / (n l_i^2))."""
+    total = 0.0
+    for i in range(weight2.shape[0]):
+        total += weight2[i] * a_q[i] * b_q[i]
+    return total + a_w * b_w / (length * length)
 
 
 def _arclength_correct(args, q, state, shear, band_size, clamp_base, clamp_rate, constrained, anchor_q,

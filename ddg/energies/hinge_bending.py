@@ -53,7 +53,7 @@ def hinge_stiffness(rest_edge_lengths: np.ndarray, rest_pair_areas: np.ndarray, 
 
 
 # ---------------------------------------------------------------------------- per element
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def triangle_normal(x, tri, out):
     """Unit normal of triangle tri (3 node indices into x (N, 3)) into out; returns |u| (twice the area)."""
     p0, p1, p2 = tri[0], tri[1], tri[2]
@@ -129,7 +129,7 @@ def triangle_terms(x, tri, n, double_area, m, grad, hess, jt, want_hessian):
             hess[r, c] *= -2.0
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def hinge_cross_block(jt_a, jt_b, stiffness, out):
     """C = -2 c_h J_a^T J_b (9 x 9; rows: triangle a's coordinates, columns: b's); enters as C + C^T."""
     for r in range(9):

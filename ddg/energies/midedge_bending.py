@@ -81,14 +81,14 @@ def face_bending_matrices(nodes: np.ndarray, triangles: np.ndarray, young_modulu
 
 
 # ---------------------------------------------------------------------------- the hinge angle
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _cross(a, b, out):
     out[0] = a[1] * b[2] - a[2] * b[1]
     out[1] = a[2] * b[0] - a[0] * b[2]
     out[2] = a[0] * b[1] - a[1] * b[0]
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _normal_jacobian(p, slots, J):
     """J (3, 12) = du/dq of u = (p1 - p0) x (p2 - p0) for the triangle on hinge slots (s0, s1, s2):
     du = sum_i dp_i x c_i, c_i = p_{i+1} - p_{i+2}, i.e. du/dp_i = -[c_i]x."""
@@ -103,7 +103,7 @@ def _normal_jacobian(p, slots, J):
         J[2, col + 0], J[2, col + 1] = c1, -c0
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _add_bilinear(slots, w, scale, H):
     """H += scale * Hessian of w . u in the 12 hinge coordinates (u of the triangle on `slots`):
     blocks (i, i+1) = -[w]x, (i+1, i) = +[w]x."""
@@ -141,7 +141,7 @@ def hinge_angle(p, want_gradient, want_hessian, grad, hess):
                             np.empty((6, 3)))
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _add_transposed_products(J1, J2, t3, r, scale, H):
     """H += scale (J1^T (-[r]x) J2 + its transpose): the second variation (dp x dq) . r; t3 (3, 12) scratch."""
     for k in range(12):

@@ -48,19 +48,19 @@ KAPPA_N, KAPPA_G, TAU = 0, 1, 2
 STENCIL_SIZE = 11
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _cross(a, b, out):
     out[0] = a[1] * b[2] - a[2] * b[1]
     out[1] = a[2] * b[0] - a[0] * b[2]
     out[2] = a[0] * b[1] - a[1] * b[0]
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _stencil(xp, xi, xn, m1e, m2e, m1f, m2f, w0, w1, w2, strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w):
     """Curvatures (strain[0:2]), the edge-form first derivatives of (kappa_n, kappa_g, tau) of one
     stencil, ge, gf (3 strains, 3) = d/de, d/df and gth (3, 2) = d/dtheta^{e,f}, and the weighted
@@ -163,7 +163,7 @@ def _stencil(xp, xi, xn, m1e, m2e, m1f, m2f, w0, w1, w2, strain, ge, gf, gth, ee
     thth[1] = -0.5 * _dot(kb, mf)
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _stencil_gradient(ge, gf, gth, c, out):
     """The 11-entry stencil gradient of strain c from its edge form (e = x_i - x_{i-1}, f = x_{i+1} - x_i)."""
     for k in range(3):
@@ -282,14 +282,14 @@ def stencil_place(size, node_stride):
     return place + (place // 4) * (node_stride - 4)
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _contraction_scratch():
     """Work arrays of the chain rule of one stencil: its 11 x 11 block and the weighted edge forms."""
     return (np.empty((STENCIL_SIZE, STENCIL_SIZE)), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)),
             np.empty((3, 2)), np.empty((3, 2)), np.empty(2))
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _add_gradient_products(second, g, count, h11):
     """h11 += sum_cd second_cd g_c g_d^T over the first `count` strains (lower triangle only)."""
     for c in range(count):
@@ -302,7 +302,7 @@ def _add_gradient_products(second, g, count, h11):
                         h11[a, b] += ga * g[d, b]
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _scatter_lower(h11, place, base, n_dof, band):
     """The stencil block's lower triangle into the flattened lower band: its DOFs are increasing in
     a, so entry (a, b), a >= b, lands at band[(place[a] - place[b]) * n_dof + base + place[b]]."""

@@ -16,7 +16,7 @@ from numba import njit
 from ..solve.band_scatter import add_entry
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def edge_stretch(e0, e1, e2, rest, k, grad, hess, want_gradient, want_hessian):
     """Energy of one edge vector e; writes dE/de (3,) and d2E/de2 (3, 3) where asked:
     dE/de = k (|e| - l) t;  d2E/de2 = k [t t^T + (1 - l/|e|) (I - t t^T)]."""

@@ -37,7 +37,7 @@ def unit(v: np.ndarray) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- compiled rows
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _transport_row(v, t_from, t_to, out):
     """out = P v, the minimal rotation taking unit t_from to unit t_to applied to v:
     P v = c v + b x v + (b . v) / (1 + c) b, b = t_from x t_to, c = t_from . t_to."""
@@ -51,7 +51,7 @@ def _transport_row(v, t_from, t_to, out):
     out[2] = c * v[2] + (b0 * v[1] - b1 * v[0]) + bv * b2
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _signed_angle(transported, d1, t):
     """Angle about t from `transported` to d1 (both normal to t)."""
     cx = transported[1] * d1[2] - transported[2] * d1[1]
@@ -61,7 +61,7 @@ def _signed_angle(transported, d1, t):
                       transported[0] * d1[0] + transported[1] * d1[1] + transported[2] * d1[2])
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def _unwrap(angle, previous):
     """angle + 2 pi k within pi of previous."""
     shifted = angle - previous + math.pi

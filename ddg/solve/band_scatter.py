@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
+@njit(cache=True, forceinline=True)
 def add_entry(band, n, r, c, value):
     """A[r, c] += value and (by symmetry) A[c, r] += value, in lower storage."""
     if r >= c:

@@ -61,19 +61,21 @@ def _dot(a, b):
 
 
 @njit(cache=True, forceinline=True)
-def _stencil(xp, xi, xn, m1e, m2e, m1f, m2f, w0, w1, w2, strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w):
+def _stencil(x, m1, m2, i, w0, w1, w2, strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w):
     """Curvatures (strain[0:2]), the edge-form first derivatives of (kappa_n, kappa_g, tau) of one
     stencil, ge, gf (3 strains, 3) = d/de, d/df and gth (3, 2) = d/dtheta^{e,f}, and the weighted
     sum of their second derivatives, w0 d2 kappa_n + w1 d2 kappa_g + w2 d2 tau: ee, ef, ff (3, 3) in
     e and f, eth, fth (3, 2) mixed with the angles, thth (2,) the angles' diagonal. The two
     curvatures' second derivatives share their dyads, so the weighted sum is formed from weighted
     vectors (D = w0 dt_n - w1 dt_g, M = w0 m2 - w1 m1, G = w0 m1 + w1 m2) in one pass; unit weights
-    give one strain's second derivatives (`_derivatives`). w: scratch (16, 3)."""
+    give one strain's second derivatives (`_derivatives`). Stencil i of the centerline x (M, 3) and
+    its edges' directors m1, m2 (M - 1, 3), read in place: a row view per stencil costs reference
+    counts in the hottest loop (docs/findings/measured.md). w: scratch (16, 3)."""
     e, f, te, tf, kb, tt, dt, big_d, pe, pf, me, mf, ge_, gf_, tmp, ae = (
         w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9], w[10], w[11], w[12], w[13], w[14], w[15])
     for k in range(3):
-        e[k] = xi[k] - xp[k]
-        f[k] = xn[k] - xi[k]
+        e[k] = x[i + 1, k] - x[i, k]
+        f[k] = x[i + 2, k] - x[i + 1, k]
     ne = math.sqrt(_dot(e, e))
     nf = math.sqrt(_dot(f, f))
     ie, jf = 1.0 / ne, 1.0 / nf
@@ -95,7 +97,7 @@ def _stencil(xp, xi, xn, m1e, m2e, m1f, m2f, w0, w1, w2, strain, ge, gf, gth, ee
         projection = 0.0
         for k in range(3):
             # kappa_n: director m2, twist directors m1 (d m2/d theta = -m1); kappa_g: m1 and m2
-            director = (m2e[k] + m2f[k]) if c == 0 else (m1e[k] + m1f[k])
+            director = (m2[i, k] + m2[i + 1, k]) if c == 0 else (m1[i, k] + m1[i + 1, k])
             projection += kb[k] * director
             dt[k] = director / chi
         kappa = sgn * 0.5 * projection
@@ -108,11 +110,11 @@ def _stencil(xp, xi, xn, m1e, m2e, m1f, m2f, w0, w1, w2, strain, ge, gf, gth, ee
             gf[c, k] = jf * (-kappa * tt[k] - sgn * pe[k])
             big_d[k] += sgn * weight * dt[k]
         if c == 0:
-            gth[c, 0] = -0.5 * _dot(kb, m1e)
-            gth[c, 1] = -0.5 * _dot(kb, m1f)
+            gth[c, 0] = -0.5 * (kb[0] * m1[i, 0] + kb[1] * m1[i, 1] + kb[2] * m1[i, 2])
+            gth[c, 1] = -0.5 * (kb[0] * m1[i + 1, 0] + kb[1] * m1[i + 1, 1] + kb[2] * m1[i + 1, 2])
         else:
-            gth[c, 0] = -0.5 * _dot(kb, m2e)
-            gth[c, 1] = -0.5 * _dot(kb, m2f)
+            gth[c, 0] = -0.5 * (kb[0] * m2[i, 0] + kb[1] * m2[i, 1] + kb[2] * m2[i, 2])
+            gth[c, 1] = -0.5 * (kb[0] * m2[i + 1, 0] + kb[1] * m2[i + 1, 1] + kb[2] * m2[i + 1, 2])
     # twist: tau = theta^f - theta^e + m_ref, linear in theta
     for k in range(3):
         ge[2, k] = 0.5 * kb[k] * ie
@@ -122,10 +124,10 @@ def _stencil(xp, xi, xn, m1e, m2e, m1f, m2f, w0, w1, w2, strain, ge, gf, gth, ee
     _cross(tf, big_d, pe)   # sum_c w_c sgn_c (tf x dt_c)
     _cross(te, big_d, pf)   # sum_c w_c sgn_c (te x dt_c)
     for k in range(3):
-        me[k] = w0 * m2e[k] - w1 * m1e[k]
-        mf[k] = w0 * m2f[k] - w1 * m1f[k]
-        ge_[k] = w0 * m1e[k] + w1 * m2e[k]
-        gf_[k] = w0 * m1f[k] + w1 * m2f[k]
+        me[k] = w0 * m2[i, k] - w1 * m1[i, k]
+        mf[k] = w0 * m2[i + 1, k] - w1 * m1[i + 1, k]
+        ge_[k] = w0 * m1[i, k] + w1 * m2[i, k]
+        gf_[k] = w0 * m1[i + 1, k] + w1 * m2[i + 1, k]
         ae[k] = te[k] + tt[k]
         tmp[k] = tf[k] + tt[k]
     big_k = weighted_kappa
@@ -251,7 +253,7 @@ def _derivatives(x, m1, m2, strains, grads, hessians):
     _, ee, ef, ff, eth, fth, thth = _contraction_scratch()
     for i in range(x.shape[0] - 2):
         for c in range(3):   # each strain's second derivatives: unit weights
-            _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1], 1.0 * (c == 0),
+            _stencil(x, m1, m2, i, 1.0 * (c == 0),
                      1.0 * (c == 1), 1.0 * (c == 2), strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w)
             _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, hessians[i, c])
         strains[i, 0], strains[i, 1] = strain[0], strain[1]
@@ -325,7 +327,7 @@ def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, 
     h11, ee, ef, ff, eth, fth, thth = _contraction_scratch()
     place = stencil_place(STENCIL_SIZE, node_stride)  # the stencil's 11 DOFs within its block
     for i in range(x.shape[0] - 2):
-        _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1], first[i, 0], first[i, 1],
+        _stencil(x, m1, m2, i, first[i, 0], first[i, 1],
                  first[i, 2], strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w)
         base = node_stride * i
         for c in range(3):
@@ -364,7 +366,7 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
     units = unit_place.shape[0]
     keep = strain_gradients.shape[0] == x.shape[0] - 2
     for i in range(x.shape[0] - 2):
-        _stencil(x[i], x[i + 1], x[i + 2], m1[i], m2[i], m1[i + 1], m2[i + 1], first[i, 1], first[i, 2],
+        _stencil(x, m1, m2, i, first[i, 1], first[i, 2],
                  first[i, 3], strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w)
         ne, nf = 0.0, 0.0
         for k in range(3):

@@ -19,7 +19,9 @@ Everything is deterministic: no random numbers, the same cases in the same order
 """
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -793,3 +795,19 @@ if __name__ == "__main__":
     if len(sys.argv) != 3 or sys.argv[1] != "report":
         sys.exit("usage: python tests/fuzz_cases.py report RECORD.jsonl")
     sys.stdout.write(report(sys.argv[2]))
+
+
+@contextlib.contextmanager
+def at_most(seconds: float, error: type = TimeoutError):
+    """SIGALRM after `seconds` raises `error`: a call that blocks (a read from a FIFO) fails the test
+    instead of hanging it."""
+    def alarm(signum, frame):
+        raise error(f"still running after {seconds:g} s")
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)

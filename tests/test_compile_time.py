@@ -1,9 +1,8 @@
-"""What made the kernels take 20 minutes to compile must not come back (issue 47): numba's IR-level
-inlining (`inline="always"`: one kernel took 123 s and 2.6 GB with it, 2.5 s without; the hot
-helpers are inlined by LLVM instead, `forceinline=True`, at a fraction of the cost), one compiled
-energy with every model's terms, and second specialisations for constant (Literal) arguments of the
-kernels that link the most code. The seconds are measured by benchmarks/compile_time.py, never
-asserted here."""
+"""What made the kernels slow to compile must not come back: numba's IR-level inlining
+(`inline="always"`, which types the caller again at every call site; the hot helpers are inlined by
+LLVM instead, `forceinline=True`), one compiled energy with every model's terms, and second
+specialisations for constant (Literal) arguments of the kernels that link the most code. The
+seconds are measured by benchmarks/compile_time.py (docs/findings/measured.md), never asserted here."""
 import re
 from pathlib import Path
 

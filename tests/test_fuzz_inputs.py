@@ -48,7 +48,6 @@ import json
 import os
 import re
 import resource
-import signal
 import subprocess
 import sys
 import time
@@ -156,17 +155,11 @@ def guarded(limit_s: float = HARD_LIMIT_S):
     if hard != resource.RLIM_INFINITY:
         ceiling = min(ceiling, hard)
 
-    def alarm(signum, frame):
-        raise CaseTimeout(f"still running after {limit_s:g} s")
-
-    previous = signal.signal(signal.SIGALRM, alarm)
     resource.setrlimit(resource.RLIMIT_AS, (ceiling, hard))
-    signal.setitimer(signal.ITIMER_REAL, limit_s)
     try:
-        yield
+        with fuzz_cases.at_most(limit_s, CaseTimeout):
+            yield
     finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
         resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
 
 

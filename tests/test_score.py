@@ -5,12 +5,10 @@ benchmark, the template filled in), malformed results refused with one line befo
 written, and `report --out FILE` refused the same way. Reads committed data only: no model is run."""
 from __future__ import annotations
 
-import contextlib
 import csv
 import importlib.util
 import math
 import os
-import signal
 import stat
 import time
 
@@ -21,6 +19,8 @@ import ddg
 from ddg.output.io import StoredRun
 from validation.__main__ import main
 from validation.reference import ROOT
+
+from fuzz_cases import at_most
 from validation.score import (BENCHMARK_RELEASES, BENCHMARK_VERSION, H_MID_ERROR_BAR_FLOOR, REQUIRED_COLUMNS,
                               load_benchmark, read_results, score_results, write_benchmark_files)
 
@@ -367,21 +367,6 @@ def test_a_results_directory_and_an_out_file_are_refused(tmp_path, capsys):
     check_refused(capsys, tmp_path, ["score", str(results), "--template", str(tmp_path / "t.csv")], "give one of")
     check_refused(capsys, tmp_path, ["score", "--template", str(tmp_path)], "is a directory")
     check_refused(capsys, tmp_path, ["score", "--benchmark", str(taken)], "--benchmark")
-
-
-@contextlib.contextmanager
-def at_most(seconds):
-    """SIGALRM after `seconds`: a read that blocks (a FIFO) fails the test instead of hanging it."""
-    def alarm(signum, frame):
-        raise TimeoutError(f"still running after {seconds} s")
-
-    previous = signal.signal(signal.SIGALRM, alarm)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
 
 
 def test_a_fifo_a_device_and_a_huge_file_are_refused_before_they_are_read(tmp_path, capsys):

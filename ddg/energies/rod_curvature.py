@@ -49,10 +49,9 @@ STENCIL_SIZE = 11
 
 
 @njit(cache=True, forceinline=True)
-def _cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
+def _cross(a, b):
+    """a x b of two 3-tuples."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 @njit(cache=True, forceinline=True)
@@ -61,7 +60,41 @@ def _dot(a, b):
 
 
 @njit(cache=True, forceinline=True)
-def _stencil(x, m1, m2, i, w0, w1, w2, strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w):
+def _combine(wa, a, wb, b):
+    """wa a + wb b of two 3-tuples."""
+    return (wa * a[0] + wb * b[0], wa * a[1] + wb * b[1], wa * a[2] + wb * b[2])
+
+
+@njit(cache=True, forceinline=True)
+def _scaled(w, a):
+    """w a of a 3-tuple."""
+    return (w * a[0], w * a[1], w * a[2])
+
+
+@njit(cache=True, forceinline=True)
+def _row(v, i):
+    """Row i of an (n, 3) array as a 3-tuple (a tuple lives in registers; a row view would cost
+    reference counts in the hottest loop, docs/findings/measured.md)."""
+    return (v[i, 0], v[i, 1], v[i, 2])
+
+
+@njit(cache=True, forceinline=True)
+def _curvature(c, sgn, director, kb, tt, te, tf, chi, ie, jf, ge, gf):
+    """One material curvature sgn kb . director / 2 (director = the sum of the two edges' m2 for
+    kappa_n, sgn = 1, or m1 for kappa_g, sgn = -1) and its edge-form gradient into row c of ge, gf;
+    returns (kappa, director / chi)."""
+    kappa = sgn * 0.5 * _dot(kb, director)
+    dt = _scaled(1.0 / chi, director)
+    pf = _cross(tf, dt)
+    pe = _cross(te, dt)
+    for k in range(3):
+        ge[c, k] = ie * (-kappa * tt[k] + sgn * pf[k])
+        gf[c, k] = jf * (-kappa * tt[k] - sgn * pe[k])
+    return kappa, dt
+
+
+@njit(cache=True, forceinline=True)
+def _stencil(x, m1, m2, i, w0, w1, w2, strain, ge, gf, gth, ee, ef, ff, eth, fth, thth):
     """Curvatures (strain[0:2]), the edge-form first derivatives of (kappa_n, kappa_g, tau) of one
     stencil, ge, gf (3 strains, 3) = d/de, d/df and gth (3, 2) = d/dtheta^{e,f}, and the weighted
     sum of their second derivatives, w0 d2 kappa_n + w1 d2 kappa_g + w2 d2 tau: ee, ef, ff (3, 3) in
@@ -69,68 +102,38 @@ def _stencil(x, m1, m2, i, w0, w1, w2, strain, ge, gf, gth, ee, ef, ff, eth, fth
     curvatures' second derivatives share their dyads, so the weighted sum is formed from weighted
     vectors (D = w0 dt_n - w1 dt_g, M = w0 m2 - w1 m1, G = w0 m1 + w1 m2) in one pass; unit weights
     give one strain's second derivatives (`_derivatives`). Stencil i of the centerline x (M, 3) and
-    its edges' directors m1, m2 (M - 1, 3), read in place: a row view per stencil costs reference
-    counts in the hottest loop (docs/findings/measured.md). w: scratch (16, 3)."""
-    e, f, te, tf, kb, tt, dt, big_d, pe, pf, me, mf, ge_, gf_, tmp, ae = (
-        w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9], w[10], w[11], w[12], w[13], w[14], w[15])
-    for k in range(3):
-        e[k] = x[i + 1, k] - x[i, k]
-        f[k] = x[i + 2, k] - x[i + 1, k]
-    ne = math.sqrt(_dot(e, e))
-    nf = math.sqrt(_dot(f, f))
-    ie, jf = 1.0 / ne, 1.0 / nf
-    for k in range(3):
-        te[k] = e[k] * ie
-        tf[k] = f[k] * jf
+    its edges' directors m1, m2 (M - 1, 3); the stencil's vectors are 3-tuples."""
+    e = _combine(1.0, _row(x, i + 1), -1.0, _row(x, i))
+    f = _combine(1.0, _row(x, i + 2), -1.0, _row(x, i + 1))
+    ie = 1.0 / math.sqrt(_dot(e, e))
+    jf = 1.0 / math.sqrt(_dot(f, f))
+    te = _scaled(ie, e)
+    tf = _scaled(jf, f)
     chi = 1.0 + _dot(te, tf)
-    _cross(te, tf, kb)
-    for k in range(3):
-        kb[k] *= 2.0 / chi
-        tt[k] = (te[k] + tf[k]) / chi
+    kb = _scaled(2.0 / chi, _cross(te, tf))
+    tt = _combine(1.0 / chi, te, 1.0 / chi, tf)
     ie2, jf2, iej = ie * ie, jf * jf, ie * jf
-    weighted_kappa = 0.0
-    for k in range(3):
-        big_d[k] = 0.0
-    for c in range(2):
-        sgn = 1.0 if c == 0 else -1.0
-        weight = w0 if c == 0 else w1
-        projection = 0.0
-        for k in range(3):
-            # kappa_n: director m2, twist directors m1 (d m2/d theta = -m1); kappa_g: m1 and m2
-            director = (m2[i, k] + m2[i + 1, k]) if c == 0 else (m1[i, k] + m1[i + 1, k])
-            projection += kb[k] * director
-            dt[k] = director / chi
-        kappa = sgn * 0.5 * projection
-        strain[c] = kappa
-        weighted_kappa += weight * kappa
-        _cross(tf, dt, pf)
-        _cross(te, dt, pe)
-        for k in range(3):
-            ge[c, k] = ie * (-kappa * tt[k] + sgn * pf[k])
-            gf[c, k] = jf * (-kappa * tt[k] - sgn * pe[k])
-            big_d[k] += sgn * weight * dt[k]
-        if c == 0:
-            gth[c, 0] = -0.5 * (kb[0] * m1[i, 0] + kb[1] * m1[i, 1] + kb[2] * m1[i, 2])
-            gth[c, 1] = -0.5 * (kb[0] * m1[i + 1, 0] + kb[1] * m1[i + 1, 1] + kb[2] * m1[i + 1, 2])
-        else:
-            gth[c, 0] = -0.5 * (kb[0] * m2[i, 0] + kb[1] * m2[i, 1] + kb[2] * m2[i, 2])
-            gth[c, 1] = -0.5 * (kb[0] * m2[i + 1, 0] + kb[1] * m2[i + 1, 1] + kb[2] * m2[i + 1, 2])
+    m1e, m1f, m2e, m2f = _row(m1, i), _row(m1, i + 1), _row(m2, i), _row(m2, i + 1)
+    # kappa_n: directors m2, twist directors m1 (d m2/d theta = -m1); kappa_g: m1 and m2
+    kappa_n, dt_n = _curvature(0, 1.0, _combine(1.0, m2e, 1.0, m2f), kb, tt, te, tf, chi, ie, jf, ge, gf)
+    kappa_g, dt_g = _curvature(1, -1.0, _combine(1.0, m1e, 1.0, m1f), kb, tt, te, tf, chi, ie, jf, ge, gf)
+    strain[0], strain[1] = kappa_n, kappa_g
+    gth[0, 0], gth[0, 1] = -0.5 * _dot(kb, m1e), -0.5 * _dot(kb, m1f)
+    gth[1, 0], gth[1, 1] = -0.5 * _dot(kb, m2e), -0.5 * _dot(kb, m2f)
     # twist: tau = theta^f - theta^e + m_ref, linear in theta
     for k in range(3):
         ge[2, k] = 0.5 * kb[k] * ie
         gf[2, k] = 0.5 * kb[k] * jf
     gth[2, 0], gth[2, 1] = -1.0, 1.0
     # the weighted vectors of the curvatures' dyads
-    _cross(tf, big_d, pe)   # sum_c w_c sgn_c (tf x dt_c)
-    _cross(te, big_d, pf)   # sum_c w_c sgn_c (te x dt_c)
-    for k in range(3):
-        me[k] = w0 * m2[i, k] - w1 * m1[i, k]
-        mf[k] = w0 * m2[i + 1, k] - w1 * m1[i + 1, k]
-        ge_[k] = w0 * m1[i, k] + w1 * m2[i, k]
-        gf_[k] = w0 * m1[i + 1, k] + w1 * m2[i + 1, k]
-        ae[k] = te[k] + tt[k]
-        tmp[k] = tf[k] + tt[k]
-    big_k = weighted_kappa
+    big_k = w0 * kappa_n + w1 * kappa_g
+    big_d = _combine(w0, dt_n, -w1, dt_g)
+    pe = _cross(tf, big_d)   # sum_c w_c sgn_c (tf x dt_c)
+    pf = _cross(te, big_d)   # sum_c w_c sgn_c (te x dt_c)
+    me = _combine(w0, m2e, -w1, m1e)
+    mf = _combine(w0, m2f, -w1, m1f)
+    ae = _combine(1.0, te, 1.0, tt)
+    af = _combine(1.0, tf, 1.0, tt)
     for a in range(3):
         for b in range(3):
             eye = 1.0 if a == b else 0.0
@@ -140,7 +143,7 @@ def _stencil(x, m1, m2, i, w0, w1, w2, strain, ge, gf, gth, ee, ef, ff, eth, fth
                         - 0.25 * w2 * ie2 * (kb[a] * ae[b] + ae[a] * kb[b]))
             ff[a, b] = (jf2 * (tt2 + (pf[a] * tt[b] + tt[a] * pf[b]) - big_k / chi * (eye - tf[a] * tf[b])
                                + 0.25 * (kb[a] * mf[b] + mf[a] * kb[b]))
-                        - 0.25 * w2 * jf2 * (kb[a] * tmp[b] + tmp[a] * kb[b]))
+                        - 0.25 * w2 * jf2 * (kb[a] * af[b] + af[a] * kb[b]))
             ef[a, b] = (iej * (-big_k / chi * (eye + te[a] * tf[b]) + tt2 + (tt[a] * pf[b] - pe[a] * tt[b]))
                         - 0.25 * w2 * iej * (kb[a] * tt[b] + tt[a] * kb[b]))
     # skew parts of the e-f block: + [D]x-like from the curvatures, - the twist's ([te]x + [tf]x) / 2 chi |e||f|
@@ -154,26 +157,27 @@ def _stencil(x, m1, m2, i, w0, w1, w2, strain, ge, gf, gth, ee, ef, ff, eth, fth
     ef[2, 0] += s1
     ef[2, 1] -= s0
     for j in range(2):
-        g_j = ge_ if j == 0 else gf_
+        g_j = _combine(w0, m1e, w1, m2e) if j == 0 else _combine(w0, m1f, w1, m2f)
         kb_g = _dot(kb, g_j)
-        _cross(tf, g_j, e)
-        _cross(te, g_j, f)
+        cross_f = _cross(tf, g_j)
+        cross_e = _cross(te, g_j)
         for k in range(3):
-            eth[k, j] = ie * (0.5 * kb_g * tt[k] - e[k] / chi)
-            fth[k, j] = jf * (0.5 * kb_g * tt[k] + f[k] / chi)
+            eth[k, j] = ie * (0.5 * kb_g * tt[k] - cross_f[k] / chi)
+            fth[k, j] = jf * (0.5 * kb_g * tt[k] + cross_e[k] / chi)
     thth[0] = -0.5 * _dot(kb, me)
     thth[1] = -0.5 * _dot(kb, mf)
 
 
 @njit(cache=True, forceinline=True)
-def _stencil_gradient(ge, gf, gth, c, out):
-    """The 11-entry stencil gradient of strain c from its edge form (e = x_i - x_{i-1}, f = x_{i+1} - x_i)."""
+def _stencil_gradient(ge, gf, gth, c, out, row):
+    """Row `row` of out: the 11-entry stencil gradient of strain c from its edge form
+    (e = x_i - x_{i-1}, f = x_{i+1} - x_i)."""
     for k in range(3):
-        out[k] = -ge[c, k]
-        out[4 + k] = ge[c, k] - gf[c, k]
-        out[8 + k] = gf[c, k]
-    out[3] = gth[c, 0]
-    out[7] = gth[c, 1]
+        out[row, k] = -ge[c, k]
+        out[row, 4 + k] = ge[c, k] - gf[c, k]
+        out[row, 8 + k] = gf[c, k]
+    out[row, 3] = gth[c, 0]
+    out[row, 7] = gth[c, 1]
 
 
 @njit(cache=True)
@@ -205,8 +209,8 @@ def _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, out):
 @njit(cache=True)
 def _scratch():
     """Work arrays of one stencil (allocated inside the compiled loops: a tuple of arrays passed
-    in from Python costs ~90 microseconds of dispatch per call): strains, ge, gf, gth, vectors."""
-    return np.empty(3), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 2)), np.empty((16, 3))
+    in from Python costs ~90 microseconds of dispatch per call): strains, ge, gf, gth."""
+    return np.empty(3), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 2))
 
 
 @njit(cache=True)
@@ -249,16 +253,16 @@ def turning_chi(x: np.ndarray) -> np.ndarray:
 
 @njit(cache=True)
 def _derivatives(x, m1, m2, strains, grads, hessians):
-    strain, ge, gf, gth, w = _scratch()
+    strain, ge, gf, gth = _scratch()
     _, ee, ef, ff, eth, fth, thth = _contraction_scratch()
     for i in range(x.shape[0] - 2):
         for c in range(3):   # each strain's second derivatives: unit weights
             _stencil(x, m1, m2, i, 1.0 * (c == 0),
-                     1.0 * (c == 1), 1.0 * (c == 2), strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w)
+                     1.0 * (c == 1), 1.0 * (c == 2), strain, ge, gf, gth, ee, ef, ff, eth, fth, thth)
             _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, hessians[i, c])
         strains[i, 0], strains[i, 1] = strain[0], strain[1]
         for c in range(3):
-            _stencil_gradient(ge, gf, gth, c, grads[i, c])
+            _stencil_gradient(ge, gf, gth, c, grads[i], c)
 
 
 def strain_derivatives(x: np.ndarray, m1: np.ndarray, m2: np.ndarray):
@@ -292,11 +296,11 @@ def _contraction_scratch():
 
 
 @njit(cache=True, forceinline=True)
-def _add_gradient_products(second, g, count, h11):
-    """h11 += sum_cd second_cd g_c g_d^T over the first `count` strains (lower triangle only)."""
+def _add_gradient_products(second, i, g, count, h11):
+    """h11 += sum_cd second[i, c, d] g_c g_d^T over the first `count` strains (lower triangle only)."""
     for c in range(count):
         for d in range(count):
-            coefficient = second[c, d]
+            coefficient = second[i, c, d]
             if coefficient != 0.0:
                 for a in range(STENCIL_SIZE):
                     ga = coefficient * g[c, a]
@@ -305,9 +309,14 @@ def _add_gradient_products(second, g, count, h11):
 
 
 @njit(cache=True, forceinline=True)
-def _scatter_lower(h11, place, base, n_dof, band):
+def _scatter_lower(h11, place, node_stride, base, n_dof, band):
     """The stencil block's lower triangle into the flattened lower band: its DOFs are increasing in
     a, so entry (a, b), a >= b, lands at band[(place[a] - place[b]) * n_dof + base + place[b]]."""
+    if node_stride == 4:   # the rod's own layout: place[a] = a, diagonal a - b of the band
+        for a in range(STENCIL_SIZE):
+            for b in range(a + 1):
+                band[(a - b) * n_dof + base + b] += h11[a, b]
+        return
     for a in range(STENCIL_SIZE):
         for b in range(a + 1):
             band[(place[a] - place[b]) * n_dof + base + place[b]] += h11[a, b]
@@ -322,23 +331,23 @@ def add_stencil_terms(x, m1, m2, first, second, node_stride, n_dof, grad, band, 
     DOF node_stride * j, edge j's twist angle follows it (the rod's layout, Eq. 1, has
     node_stride = 4; a model with more DOFs per edge, ddg.models.wide_ribbons.CrossSectionRibbon,
     puts them after the angle), so stencil i starts at DOF node_stride * i."""
-    strain, ge, gf, gth, w = _scratch()
+    strain, ge, gf, gth = _scratch()
     g11 = np.empty((3, STENCIL_SIZE))
     h11, ee, ef, ff, eth, fth, thth = _contraction_scratch()
     place = stencil_place(STENCIL_SIZE, node_stride)  # the stencil's 11 DOFs within its block
     for i in range(x.shape[0] - 2):
         _stencil(x, m1, m2, i, first[i, 0], first[i, 1],
-                 first[i, 2], strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w)
+                 first[i, 2], strain, ge, gf, gth, ee, ef, ff, eth, fth, thth)
         base = node_stride * i
         for c in range(3):
-            _stencil_gradient(ge, gf, gth, c, g11[c])
+            _stencil_gradient(ge, gf, gth, c, g11, c)
         for a in range(STENCIL_SIZE):
             grad[base + place[a]] += first[i, 0] * g11[0, a] + first[i, 1] * g11[1, a] + first[i, 2] * g11[2, a]
         if not want_hessian:
             continue
         _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, h11)
-        _add_gradient_products(second[i], g11, 3, h11)
-        _scatter_lower(h11, place, node_stride * i, n_dof, band)
+        _add_gradient_products(second, i, g11, 3, h11)
+        _scatter_lower(h11, place, node_stride, node_stride * i, n_dof, band)
 
 
 
@@ -356,7 +365,7 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
     (n, 4, 11): filled with each stencil's gradients of (eps, kappa_n, kappa_g, tau) over its rod
     DOFs (for terms coupling neighbouring stencils' strains, `add_pair_cross_terms`), when it has
     n rows."""
-    strain, ge, gf, gth, w = _scratch()
+    strain, ge, gf, gth = _scratch()
     g = np.empty((4, STENCIL_SIZE))
     h11, ee, ef, ff, eth, fth, thth = _contraction_scratch()
     te = np.empty(3)
@@ -367,7 +376,7 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
     keep = strain_gradients.shape[0] == x.shape[0] - 2
     for i in range(x.shape[0] - 2):
         _stencil(x, m1, m2, i, first[i, 1], first[i, 2],
-                 first[i, 3], strain, ge, gf, gth, ee, ef, ff, eth, fth, thth, w)
+                 first[i, 3], strain, ge, gf, gth, ee, ef, ff, eth, fth, thth)
         ne, nf = 0.0, 0.0
         for k in range(3):
             te[k] = x[i + 1, k] - x[i, k]
@@ -385,7 +394,7 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
         g[0, 3] = 0.0
         g[0, 7] = 0.0
         for c in range(3):
-            _stencil_gradient(ge, gf, gth, c, g[1 + c])
+            _stencil_gradient(ge, gf, gth, c, g, 1 + c)
         if keep:
             for c in range(4):
                 for a in range(STENCIL_SIZE):
@@ -405,8 +414,8 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
                 ee[a, b] += se * (eye - te[a] * te[b])
                 ff[a, b] += sf * (eye - tf[a] * tf[b])
         _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, h11)
-        _add_gradient_products(second[i], g, 4, h11)
-        _scatter_lower(h11, place, base, n_dof, band)
+        _add_gradient_products(second, i, g, 4, h11)
+        _scatter_lower(h11, place, node_stride, base, n_dof, band)
         # the strains against the unit strains, and the unit strains among themselves
         for j in range(units):
             rj = unit_place[j]

@@ -32,6 +32,8 @@ REPO = Path(__file__).resolve().parents[1]
 #: (model, resolution): every model at its default resolution, the rod also at M = 400.
 CASES = (("rod", 100), ("rod", 400), ("ribbon", 101), ("ribbon-sano-wada", 101), ("ribbon-trapeze", 101),
          ("ribbon-cross-section", 101), ("ribbon-wunderlich", 101), ("plate", 2000), ("plate-midedge", 2000))
+#: Issue 47's bound on a kernel's evaluation time against the tree before a change: within 5 %.
+BOUND = 0.05
 MODES = (("gradient and Hessian", True, True), ("gradient", True, False), ("energy", False, False))
 
 CHILD = r"""
@@ -102,12 +104,21 @@ def main(argv=None) -> int:
                 cell += f" ({1e6 * other:.1f}, x{best['this'][i][j] / other:.3f})"
             cells.append(cell)
         rows.append(cells)
+    summary = []
+    if args.against:
+        ratios = [(best["this"][i][j] / best["other"][i][j], f"{name} at {resolution}, {MODES[j][0]}")
+                  for i, (name, resolution) in enumerate(CASES) for j in range(len(MODES))]
+        worst = max(ratios)
+        beyond = [label for ratio, label in ratios if ratio > 1.0 + BOUND]
+        summary = [f"Largest ratio this / other: x{worst[0]:.3f} ({worst[1]}); "
+                   + (f"beyond x{1 + BOUND:.2f}: {'; '.join(beyond)}." if beyond else
+                      f"every evaluation within x{1 + BOUND:.2f} of the other tree's."), ""]
     caption = ("Minimum over rounds of the per-round median time of one `model.evaluate` call, microseconds"
                + ("; in brackets the other tree's time and the ratio this / other" if args.against else "") + ".")
     markdown = "\n".join(["# Kernel evaluation times", "", caption, "", markdown_table(header, rows), "",
                           f"Trees: {report['trees']}; {args.rounds} rounds of {args.calls} calls; load average "
                           f"{load_before} before, {report['load_after']} after; "
-                          f"{report['machine'].get('cpu_model', '?')}.", ""])
+                          f"{report['machine'].get('cpu_model', '?')}.", ""] + summary)
     print(markdown)
     print(write_report(args.out, "kernel_evaluation", report, markdown))
     return 0

@@ -145,14 +145,16 @@ def _worker(part: str) -> tuple[str, float]:
 
 #: The parts whose kernels are the same (the rod's kind of width terms): warmed in one process, in order.
 SAME_KERNELS = ("rod", "ribbon", "ribbon-sano-wada")
-#: The order in which parts are handed to the workers: the longest first (benchmarks/compile_time.py).
-LONGEST_FIRST = ("ribbon-cross-section", "rod", "ribbon-wunderlich", "ribbon-trapeze", "plate-midedge", "plate",
-                 "arrays")
+#: The order in which parts are handed to the workers: the longest first, then the parts that share
+#: none of its kernels (the plates, the array interfaces), so that the other rod-family parts start
+#: once it has cached the kernels they share with it (frames, stencils, stretched chain rule).
+WARM_ORDER = ("ribbon-cross-section", "plate-midedge", "plate", "arrays", "rod", "ribbon-wunderlich",
+              "ribbon-trapeze")
 
 
 def compile_in_parallel(parts=None, jobs: int | None = None) -> dict:
-    """compile_kernels over `jobs` worker processes (spawned: each has its own numba), the longest
-    parts first. The parts that compile the same kernels go to one worker in order (the rod's, then
+    """compile_kernels over `jobs` worker processes (spawned: each has its own numba), in
+    WARM_ORDER. The parts that compile the same kernels go to one worker in order (the rod's, then
     the ribbons that share its compiled energy and solvers, which load them from the cache);
     other parts share only small kernels, which two workers may both compile."""
     parts = list(PARTS if parts is None else parts)
@@ -166,7 +168,7 @@ def compile_in_parallel(parts=None, jobs: int | None = None) -> dict:
     queues = {p: [p] for p in parts if p not in SAME_KERNELS}
     if same:
         queues["rod"] = same
-    order = sorted(queues, key=lambda p: LONGEST_FIRST.index(p) if p in LONGEST_FIRST else len(LONGEST_FIRST))
+    order = sorted(queues, key=lambda p: WARM_ORDER.index(p) if p in WARM_ORDER else len(WARM_ORDER))
     timings = {}
     with cf.ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:
         for done in pool.map(compile_kernels, [queues[p] for p in order]):

@@ -368,8 +368,6 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
     strain, ge, gf, gth = _scratch()
     g = np.empty((4, STENCIL_SIZE))
     h11, ee, ef, ff, eth, fth, thth = _contraction_scratch()
-    te = np.empty(3)
-    tf = np.empty(3)
     mixed = np.empty(STENCIL_SIZE)
     place = stencil_place(STENCIL_SIZE, node_stride)
     units = unit_place.shape[0]
@@ -377,17 +375,12 @@ def add_stretched_stencil_terms(x, m1, m2, rest_edge_lengths, first, second, nod
     for i in range(x.shape[0] - 2):
         _stencil(x, m1, m2, i, first[i, 1], first[i, 2],
                  first[i, 3], strain, ge, gf, gth, ee, ef, ff, eth, fth, thth)
-        ne, nf = 0.0, 0.0
-        for k in range(3):
-            te[k] = x[i + 1, k] - x[i, k]
-            tf[k] = x[i + 2, k] - x[i + 1, k]
-            ne += te[k] * te[k]
-            nf += tf[k] * tf[k]
-        ne, nf = math.sqrt(ne), math.sqrt(nf)
+        e = _combine(1.0, _row(x, i + 1), -1.0, _row(x, i))
+        f = _combine(1.0, _row(x, i + 2), -1.0, _row(x, i + 1))
+        ne, nf = math.sqrt(_dot(e, e)), math.sqrt(_dot(f, f))
+        te, tf = _scaled(1.0 / ne, e), _scaled(1.0 / nf, f)
         rest = rest_edge_lengths[i] + rest_edge_lengths[i + 1]
         for k in range(3):
-            te[k] /= ne
-            tf[k] /= nf
             g[0, k] = -te[k] / rest
             g[0, 4 + k] = (te[k] - tf[k]) / rest
             g[0, 8 + k] = tf[k] / rest

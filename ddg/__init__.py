@@ -5,7 +5,8 @@ from .output import io
 from .output.io import StoredRun
 from .protocol.results import SimulationResult
 from .protocol.validity import ValidityWarning
-from .geometry.strip import InputError, LoadingProtocol, Strip, shear_limit
+from .limits import InputError
+from .geometry.strip import LoadingProtocol, Strip, shear_limit
 from .solve.continuation import ContinuationOptions
 from .solve.newton import NewtonOptions
 from .version import __version__

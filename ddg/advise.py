@@ -70,7 +70,8 @@ import os
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from .geometry.strip import InputError, Strip
+from .limits import InputError
+from .geometry.strip import Strip
 
 ROOT = Path(__file__).resolve().parent.parent
 #: The committed error map (python -m validation.error_map --out data/error_map).

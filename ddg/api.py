@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from .analysis.observables import observe
-from .geometry.strip import InputError, LoadingProtocol, Strip
+from .limits import InputError
+from .geometry.strip import LoadingProtocol, Strip
 from .models.ribbon import RIBBON_INITS
 from .protocol.after import BranchStep, Brackets, ThresholdStep
 from .protocol.driver import AfterStep, Loading, Run, execute

@@ -15,7 +15,8 @@ import sys
 from pathlib import Path
 
 from .cli_parser import EXIT_BAD_INPUT, OneLineParser
-from .geometry.strip import InputError, LoadingProtocol, Strip
+from .limits import InputError
+from .geometry.strip import LoadingProtocol, Strip
 
 EXIT_NOT_CONVERGED = 3
 EXIT_INTERNAL = 1
@@ -138,7 +139,7 @@ MAX_LIST_VALUES = 50
 
 
 def _ratios(name: str, text: str, low: float, high: float, low_inclusive: bool = False) -> list[float]:
-    from .analysis.centerline_approx import check_ratios
+    from .limits import check_ratios
 
     values = [v for v in str(text).split(",") if v.strip()] or [text]
     if len(values) > MAX_LIST_VALUES:
@@ -198,7 +199,8 @@ def _require_extra(module: str, extra: str) -> None:
 
 def cmd_curvatures(args) -> int:
     """Curvature profiles at the requested shears: OUT/curvatures.csv and OUT/curvatures.png."""
-    from .analysis.curvatures import centerline_curvatures, inflection_jumps, states_at_shears, write_curvatures_csv
+    from .analysis.curvatures import centerline_curvatures, inflection_jumps
+    from .studies.curvature_studies import states_at_shears, write_curvatures_csv
     from .output.io import save_figure
 
     from .api import check_resolution
@@ -291,7 +293,7 @@ def cmd_centerline_error(args) -> int:
     import csv
     import io as _io
 
-    from .analysis.centerline_approx import centerline_error_study
+    from .studies.centerline_error import centerline_error_study
     from .output.io import atomic_write_text, save_figure
 
     from .api import check_resolution

@@ -120,7 +120,7 @@ def _arrays(rng) -> None:
 def compile_part(part: str) -> float:
     """Compile (or load) one part's kernels; returns its seconds."""
     if part not in PARTS:
-        from .geometry.strip import InputError
+        from .limits import InputError
 
         raise InputError(f"warm-up part {part!r} is not one of {', '.join(PARTS)}")
     start = time.perf_counter()

@@ -1,5 +1,15 @@
 """Fixtures shared by several test modules."""
+import signal
+
 import pytest
+
+
+def pytest_configure(config):
+    """The Ctrl-C tests need Python's own SIGINT handler: a suite started in the background by a
+    shell without job control (`cmd &` in a script, nohup) inherits SIGINT ignored, and the
+    commands rightly keep an ignored SIGINT ignored (ddg.output.interrupts)."""
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")

@@ -118,6 +118,41 @@ def test_no_import_circles():
     assert not found, f"import circles: {found}"
 
 
+def folder_graph(graph: dict[str, set[str]]) -> tuple[dict[str, set[str]], dict[tuple[str, str], set[tuple[str, str]]]]:
+    """ddg's rooms (its sub-packages and its top-level modules, ddg/__init__ and __main__ aside: they
+    face the user) -> the rooms they import; (room, room) -> the module imports behind the edge."""
+    def room(module: str) -> str | None:
+        parts = module.split(".")
+        if parts[0] != "ddg" or module in ("ddg", "ddg.__main__"):
+            return None
+        return parts[1]
+
+    rooms: dict[str, set[str]] = {}
+    behind: dict[tuple[str, str], set[tuple[str, str]]] = {}
+    for module, targets in graph.items():
+        a = room(module)
+        if a is None:
+            continue
+        rooms.setdefault(a, set())
+        for target in targets:
+            b = room(target)
+            if b is not None and b != a:
+                rooms[a].add(b)
+                behind.setdefault((a, b), set()).add((module, target))
+    return rooms, behind
+
+
+def test_no_import_circles_between_ddgs_folders():
+    """The floors stand on each other one way: inputs (limits) below geometry, the assembly below
+    the energies and the solvers, the solvers below the models, analysis below output, protocol and
+    the api, the studies that run paths above the api. A loop between two folders, lazy imports
+    included, means two floors that cannot be understood apart."""
+    rooms, behind = folder_graph(import_graph()[0])
+    loops = cycles(rooms)
+    assert not loops, [(loop, sorted(edge for pair, edges in behind.items() if set(pair) <= set(loop)
+                                     for edge in edges)) for loop in loops]
+
+
 def test_no_private_names_imported_across_modules():
     _, private = import_graph()
     used = {m: sorted(p) for m, p in private.items() if p}

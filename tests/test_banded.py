@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from ddg.solve.band_scatter import add_pair_block, add_symmetric_block
+from ddg.assembly.band_scatter import add_pair_block, add_symmetric_block
 from ddg.solve.banded import SymmetricBanded
 
 

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import ddg
-from ddg.analysis.centerline_approx import (centerline_error_field, centerline_error_study, centerline_frame,
-                                            edge_reconstruction)
-from ddg.analysis.curvatures import states_at_shears
+from ddg.analysis.centerline_approx import centerline_error_field, centerline_frame, edge_reconstruction
+from ddg.studies.centerline_error import centerline_error_study
+from ddg.studies.curvature_studies import states_at_shears
 from ddg.models.plate import PlateModel
 
 

@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 
 import ddg
-from ddg.analysis.curvatures import (CURVATURE_COLUMNS, centerline_curvatures, framed_curve_curvatures,
-                                     inflection_jumps,
-                            states_at_shears, write_curvatures_csv)
+from ddg.analysis.curvatures import CURVATURE_COLUMNS, centerline_curvatures, framed_curve_curvatures, inflection_jumps
+from ddg.studies.curvature_studies import states_at_shears, write_curvatures_csv
 from ddg.geometry.strip import InputError
 
 STRIP = ddg.Strip.from_ratios(0.05, 0.5)
@@ -93,7 +92,7 @@ def test_plate_twist_at_the_inflection_falls_as_the_plate_thins():
     as L/b grows from 300 to 1200 (the surface tends to a developable one), for W/L = 1/20 and
     1/6. Measured (846 / 952 triangles): tau L = 3.00, 2.76, 2.31 and 1.82, 1.44, 1.21; as a
     share of the largest |tau L|: 0.66, 0.59, 0.47 and 0.32, 0.24, 0.20."""
-    from ddg.analysis.curvatures import inflection_twist_study
+    from ddg.studies.curvature_studies import inflection_twist_study
 
     rows = inflection_twist_study()
     for ratio in (1 / 20, 1 / 6):

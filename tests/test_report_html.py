@@ -469,7 +469,7 @@ def test_the_fig9_generator_refuses_a_bad_out_and_skips_finished_widths(tmp_path
     for width in pf.FIG9_WIDTHS:                     # every width finished: nothing is run
         pf.field_file(tmp_path / "out", width).parent.mkdir(parents=True, exist_ok=True)
         pf.field_file(tmp_path / "out", width).write_text("W_over_L\n")
-    import ddg.analysis.curvatures as curvatures
+    import ddg.studies.curvature_studies as curvatures
     monkeypatch.setattr(curvatures, "states_at_shears", lambda *a, **k: 1 / 0)
     assert pf.write_fields(tmp_path / "out", quiet=True) == []
     for width in pf.FIG9_WIDTHS:                     # Fig. 9a: a width with its centreline file is finished

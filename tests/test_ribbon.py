@@ -16,7 +16,7 @@ import ddg
 from ddg.cli import main
 from ddg.output.io import read_path_csv
 from ddg.models.ribbon import DEFAULT_ZETA_OVER_L, RibbonModel
-from ddg.analysis.pitchfork import pitchfork_analysis
+from ddg.studies.pitchfork import pitchfork_analysis
 from ddg.api import run_ribbon
 
 STRIP = ddg.Strip.from_ratios(0.05, 0.5)

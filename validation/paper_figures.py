@@ -2,7 +2,7 @@
 the plate, Eq. 13): `python -m validation.paper_figures --out data/paper_figures`.
 
 For W/L in FIG9_WIDTHS at dL/L = 1/2, the plate on FIG9_TRIANGLES triangles is followed along its
-stable path to each dW/L of FIG9_SHEARS (ddg.analysis.curvatures.states_at_shears), and at every
+stable path to each dW/L of FIG9_SHEARS (ddg.studies.curvature_studies.states_at_shears), and at every
 node the distance delta(s, w) / L from the plate's deformed node to the position the centreline
 and its material frame give it (Eq. 12; ddg.analysis.centerline_approx.centerline_error_field) is
 written to OUT/fig9/W<W/L>.csv (columns W_over_L, dW_over_L, s_over_L, w_over_L,
@@ -47,7 +47,7 @@ def write_figure9(out: Path, widths=FIG9_WIDTHS, shears=FIG9_SHEARS, triangles: 
     centreline file)."""
     import ddg
     from ddg.analysis.centerline_approx import centerline_error_field, centerline_frame
-    from ddg.analysis.curvatures import states_at_shears
+    from ddg.studies.curvature_studies import states_at_shears
     from ddg.output.io import atomic_write_text
 
     written = []

@@ -16,7 +16,7 @@ import math
 from scipy.optimize import brentq
 from scipy.special import ellipe, ellipk
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 
 #: clamped-clamped Euler loads P L^2 / EI: symmetric (4 pi^2) and antisymmetric (8.18 pi^2) modes
 EULER_SYMMETRIC = 4.0 * math.pi**2

@@ -22,7 +22,6 @@ import numpy as np
 
 from .curvatures import plate_points, framed_curve_curvatures, plate_centerline_frame
 from ..geometry.frames import cross, unit
-from ..geometry.strip import InputError, Strip
 
 PAPER_WIDTH_RATIOS = (1 / 2, 1 / 3, 1 / 6, 1 / 12, 1 / 20)  # L/W in {2, 3, 6, 12, 20}
 PAPER_SHEAR_RATIOS = (0.1, 0.3, 0.5)
@@ -97,64 +96,3 @@ def edge_reconstruction(model, q: np.ndarray) -> dict:
             "rod_error": rod_err, "ribbon_error": ribbon_err,
             "rod_mean": float(rod_err.mean()), "rod_max": float(rod_err.max()),
             "ribbon_mean": float(ribbon_err.mean()), "ribbon_max": float(ribbon_err.max())}
-
-
-def centerline_error_study(width_ratios=PAPER_WIDTH_RATIOS, shear_ratios=PAPER_SHEAR_RATIOS, compression_ratio=0.5,
-                           triangles: int = 800, slenderness: float | None = None, max_step: float = 0.05,
-                           options=None, progress=None) -> list[dict]:
-    """Fig. 10: mean and max of delta (Eq. 13) against L/W at each dW/L, one plate run per width
-    along its stable path (branch switching on). A run that stops converging records NaN for the
-    shears it did not reach, with the message. progress(text) is called after each (width, shear)
-    state is measured (e.g. ddg.protocol.progress.ProgressBar.update)."""
-    from .curvatures import states_at_shears
-    from ..solve.continuation import ContinuationFailure
-
-    rows = []
-    for ratio in width_ratios:
-        strip = Strip.from_ratios(ratio, compression_ratio, slenderness)
-        L = strip.length
-        limit = strip.shear_limit(compression_ratio * L) / L
-        wanted = [r for r in shear_ratios if r <= limit]
-        done = set()
-        message = ""
-        try:
-            for model, state in states_at_shears("plate", strip, compression_ratio, wanted, triangles,
-                                                 max_step=max_step, options=options):
-                from ..solve.state import phase_label
-
-                field = centerline_error_field(model, state.q)
-                edges = edge_reconstruction(model, state.q)
-                shear = state.shear / L
-                done.add(round(shear, 9))
-                rows.append({"L_over_W": 1.0 / ratio, "W_over_L": ratio, "dW_over_L": shear,
-                             "mean_error": field["mean"], "max_error": field["max"],
-                             "rod_edge_mean_error": edges["rod_mean"], "ribbon_edge_mean_error": edges["ribbon_mean"],
-                             "phase": phase_label(model, state.q, state.compression, state.shear),
-                             "triangles": model.mesh.triangle_count, "message": ""})
-                if progress is not None:
-                    progress(f"W/L = {ratio:.4g}, dW/L = {shear:.3g}: mean delta {field['mean']:.2e}")
-        except ContinuationFailure as exc:
-            message = str(exc)
-        for r in shear_ratios:
-            if round(r, 9) not in done:
-                rows.append({"L_over_W": 1.0 / ratio, "W_over_L": ratio, "dW_over_L": r, "mean_error": float("nan"),
-                             "max_error": float("nan"), "rod_edge_mean_error": float("nan"),
-                             "ribbon_edge_mean_error": float("nan"), "phase": "", "triangles": None,
-                             "message": message or f"beyond the shear limit dW_max/L = {limit:.4g} (Eq. B.1)"})
-    return rows
-
-
-def check_ratios(name: str, values, low: float, high: float, low_inclusive: bool = False) -> list[float]:
-    """Parse a list of ratios within (low, high] ([low, high] with low_inclusive); InputError naming
-    the bad value otherwise."""
-    out = []
-    bracket = "[" if low_inclusive else "("
-    for v in values:
-        try:
-            f = float(v)
-        except (TypeError, ValueError):
-            raise InputError(f"{name} = {v!r} is not a number; allowed {bracket}{low:g}, {high:g}]") from None
-        if not ((low <= f if low_inclusive else low < f) and f <= high):
-            raise InputError(f"{name} = {f:g} outside the allowed range {bracket}{low:g}, {high:g}]")
-        out.append(f)
-    return out

@@ -39,7 +39,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..solve.band_scatter import add_pair_block, add_symmetric_block
+from ..assembly.band_scatter import add_pair_block, add_symmetric_block
 
 
 def hinge_stiffness(rest_edge_lengths: np.ndarray, rest_pair_areas: np.ndarray, bending_stiffness: float) -> np.ndarray:

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..solve.band_scatter import add_symmetric_block
+from ..assembly.band_scatter import add_symmetric_block
 
 _S = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]]])
 
@@ -45,7 +45,7 @@ def face_membrane_matrices(nodes: np.ndarray, triangles: np.ndarray, young_modul
 @njit(cache=True)
 def add_membrane_terms(x, triangles, C, abar, vertex_dof, n, grad, band, want_gradient, want_hessian):
     """Membrane energy sum_f 1/2 delta^T C_f delta; adds the gradient into grad (n,) and the
-    Hessian into the flattened lower band (ddg.solve.band_scatter). vertex_dof (N, 3)."""
+    Hessian into the flattened lower band (ddg.assembly.band_scatter). vertex_dof (N, 3)."""
     energy = 0.0
     dofs = np.empty(9, dtype=np.int64)
     J = np.empty((3, 9))

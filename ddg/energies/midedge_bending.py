@@ -47,7 +47,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..solve.band_scatter import add_symmetric_block
+from ..assembly.band_scatter import add_symmetric_block
 
 #: Role of a triangle on one of its edges: the edge's first triangle (and a free edge's only one),
 #: phi = theta; its second triangle, phi = -(theta + psi).
@@ -249,7 +249,7 @@ def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT,
 def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge, hinges, K,
                       vertex_dof, edge_dof, n, grad, band, want_gradient, want_hessian):
     """Bending energy sum_f 1/2 phi_f^T K_f phi_f of the mid-edge plate; adds its gradient into
-    grad (n,) and its Hessian into the lower band (flattened, ddg.solve.band_scatter).
+    grad (n,) and its Hessian into the lower band (flattened, ddg.assembly.band_scatter).
 
     x (N, 3) positions, theta (E,) edge angles; face_edges (T, 3) the edge opposite each vertex,
     face_roles (T, 3) ROLE_FIRST / ROLE_SECOND, hinge_of_edge (E,) the edge's row in hinges (H, 4)

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 from .rod_curvature import KAPPA_N, TAU
 
 

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..solve.band_scatter import add_symmetric_block
+from ..assembly.band_scatter import add_symmetric_block
 
 _S = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]]])
 
@@ -78,7 +78,7 @@ def plane_stress_matrix(young_modulus: float, thickness: float, poisson_ratio: f
 def add_smoothed_membrane_terms(x, triangles, T, abar, pointer, patch_faces, weights, patch_area, C, scale,
                                 vertex_dof, n, grad, band, want_gradient, want_hessian):
     """scale * sum_P A_P W(eps_P); adds scale times its gradient into grad (n,) and its Hessian
-    into the flattened lower band (ddg.solve.band_scatter). vertex_dof (N, 3)."""
+    into the flattened lower band (ddg.assembly.band_scatter). vertex_dof (N, 3)."""
     energy = 0.0
     max_faces = 0
     for P in range(pointer.shape[0] - 1):

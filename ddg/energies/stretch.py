@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..solve.band_scatter import add_entry
+from ..assembly.band_scatter import add_entry
 
 
 @njit(cache=True, forceinline=True)

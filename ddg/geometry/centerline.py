@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .strip import InputError
+from ..limits import InputError
 
 MIN_NODES = 7
 

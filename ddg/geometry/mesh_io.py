@@ -25,7 +25,7 @@ import numpy as np
 from ..limits import check_integer
 from .plate_mesh import (DEFAULT_TRIANGLES, MAX_TRIANGLES, PlateMesh, check_mesh_memory, check_plate_size,
                          mesh_from_arrays)
-from .strip import InputError
+from ..limits import InputError
 
 #: Cells a mesh file may hold besides its triangles (gmsh's boundary lines and corner points);
 #: any other cell (quads, quadratic triangles, polygons, volumes) would be silently dropped.

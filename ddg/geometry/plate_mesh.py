@@ -30,7 +30,7 @@ from functools import cached_property
 import numpy as np
 
 from ..limits import check_integer, check_memory
-from .strip import InputError
+from ..limits import InputError
 
 #: Default target triangle count, as in the paper (N_mesh ~ 2000).
 DEFAULT_TRIANGLES = 2000

@@ -10,47 +10,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+from ..limits import (MAX_RECORDED_STEPS, InputError, check_positive, check_within,  # noqa: F401
+                      is_bool, require)
+
 #: Paper defaults (section 2): clamps 75 mm apart after compression, shim stock b = 0.127 mm.
 CLAMP_SPAN_AFTER_COMPRESSION = 75e-3
 PAPER_THICKNESS = 0.127e-3
 PAPER_YOUNG_MODULUS = 100e9
-
-#: Largest recorded steps per stage. A recorded step costs an eigenvalue solve and an observation
-#: (3-10 ms on the rod, ~0.1 s on a 2000-triangle plate): 5000 steps take minutes; 1e5 would take
-#: hours and gain nothing (the continuation subdivides steps where it must).
-MAX_RECORDED_STEPS = 5000
-
-
-class InputError(ValueError):
-    """A scene or solver input outside its allowed range (one-line message)."""
-
-
-def _is_bool(value) -> bool:
-    """True and False (Python's or numpy's) are not numbers here: width_ratio=True is a mistake."""
-    return isinstance(value, bool) or type(value).__name__ == "bool_"
-
-
-def _require(condition: bool, message: str) -> None:
-    if not condition:
-        raise InputError(message)
-
-
-def _finite_positive(name: str, value: float) -> float:
-    if _is_bool(value):
-        raise InputError(f"{name} = {value!r} is a bool; it must be a positive number")
-    try:
-        value = float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise InputError(f"{name} = {value!r} is not a number; it must be a positive number") from None
-    _require(math.isfinite(value) and value > 0.0, f"{name} = {value!r} must be a positive finite number")
-    return value
-
-
-def _within(name: str, value: float, low: float, high: float, unit: str, why: str) -> float:
-    _require(low <= value <= high,
-             f"{name} = {value:g}{unit} outside the allowed range [{low:g}, {high:g}]{unit}; {why}")
-    return value
-
 
 #: Physical ranges checked when a Strip is built (SI). They keep every derived stiffness and
 #: energy far inside the float range and the scene inside the models' validity:
@@ -101,31 +67,31 @@ class Strip:
 
     def __post_init__(self) -> None:
         for name in ("length", "width", "thickness", "young_modulus", "density"):
-            object.__setattr__(self, name, _finite_positive(name, getattr(self, name)))
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         if self.design_compression_ratio is not None:
             object.__setattr__(self, "design_compression_ratio", _compression_ratio(self.design_compression_ratio))
         nu = self.poisson_ratio
-        if _is_bool(nu):
+        if is_bool(nu):
             raise InputError(f"poisson_ratio = {nu!r} is a bool; allowed range [0, 0.5)")
         try:
             nu = float(nu)
         except (TypeError, ValueError, OverflowError):
             raise InputError(f"poisson_ratio = {nu!r} is not a number; allowed range [0, 0.5)") from None
-        _require(math.isfinite(nu) and 0.0 <= nu < 0.5, f"poisson_ratio = {nu!r} outside the allowed range [0, 0.5)")
+        require(math.isfinite(nu) and 0.0 <= nu < 0.5, f"poisson_ratio = {nu!r} outside the allowed range [0, 0.5)")
         object.__setattr__(self, "poisson_ratio", nu)
-        _within("length L", self.length, *LENGTH_RANGE, " m", "the scene is scale-free: give L in metres")
-        _within("young_modulus E", self.young_modulus, *YOUNG_MODULUS_RANGE, " Pa",
+        check_within("length L", self.length, *LENGTH_RANGE, " m", "the scene is scale-free: give L in metres")
+        check_within("young_modulus E", self.young_modulus, *YOUNG_MODULUS_RANGE, " Pa",
                 "from soft gels to above diamond; the geometry does not depend on E")
-        _within("density", self.density, *DENSITY_RANGE, " kg/m^3", "used by the dynamic solver")
-        _require(
+        check_within("density", self.density, *DENSITY_RANGE, " kg/m^3", "used by the dynamic solver")
+        require(
             self.width <= self.length,
             f"width W = {self.width:g} m exceeds length L = {self.length:g} m; allowed 0 < W <= L",
         )
-        _require(
+        require(
             self.thickness < self.width,
             f"thickness b = {self.thickness:g} m must be smaller than width W = {self.width:g} m (0 < b < W)",
         )
-        _within("slenderness L/b", self.length / self.thickness, *SLENDERNESS_RANGE, "",
+        check_within("slenderness L/b", self.length / self.thickness, *SLENDERNESS_RANGE, "",
                 "a thin strip (b << L) whose stretching and bending stiffnesses stay within round-off of each other")
 
     @classmethod
@@ -146,9 +112,9 @@ class Strip:
         if slenderness is None:
             thickness = PAPER_THICKNESS
         else:
-            slenderness = _finite_positive("slenderness L/b", slenderness)
+            slenderness = check_positive("slenderness L/b", slenderness)
             low, high = SLENDERNESS_RANGE
-            _require(low <= slenderness <= high, f"slenderness L/b = {slenderness:g} outside the allowed range "
+            require(low <= slenderness <= high, f"slenderness L/b = {slenderness:g} outside the allowed range "
                      f"[{low:g}, {high:g}]: a thin strip (b << L) within round-off of double precision")
             thickness = length / slenderness
         return cls(length=length, width=width_ratio * length, thickness=thickness,
@@ -219,7 +185,7 @@ class Strip:
 
 
 def _ratio(name: str, value, low: float, high: float, upper_inclusive: bool = False) -> float:
-    if _is_bool(value):
+    if is_bool(value):
         raise InputError(f"{name} = {value!r} is a bool, not a number")
     try:
         value = float(value)
@@ -227,7 +193,7 @@ def _ratio(name: str, value, low: float, high: float, upper_inclusive: bool = Fa
         raise InputError(f"{name} = {value!r} is not a number") from None
     upper_ok = value <= high if upper_inclusive else value < high
     bracket = "]" if upper_inclusive else ")"
-    _require(
+    require(
         math.isfinite(value) and value > low and upper_ok,
         f"{name} = {value!r} outside the allowed range ({low:g}, {high:g}{bracket}",
     )
@@ -238,7 +204,7 @@ def _compression_ratio(value) -> float:
     """dL/L in COMPRESSION_RATIO_RANGE (see there)."""
     value = _ratio("compression_ratio dL/L", value, 0.0, 1.0)
     low, high = COMPRESSION_RATIO_RANGE
-    _require(low <= value <= high, f"compression_ratio dL/L = {value!r} outside the allowed range [{low:g}, {high:g}]: "
+    require(low <= value <= high, f"compression_ratio dL/L = {value!r} outside the allowed range [{low:g}, {high:g}]: "
              "below it the strip is barely buckled, above it the elastica closes on itself "
              "(self-contact, not modelled)")
     return value
@@ -264,21 +230,21 @@ class LoadingProtocol:
         object.__setattr__(self, "compression_ratio", _compression_ratio(self.compression_ratio))
         for name in ("compression_steps", "shear_steps"):
             value = getattr(self, name)
-            _require(
-                isinstance(value, int) and not _is_bool(value) and 1 <= value <= MAX_RECORDED_STEPS,
+            require(
+                isinstance(value, int) and not is_bool(value) and 1 <= value <= MAX_RECORDED_STEPS,
                 f"{name} = {value!r} must be an integer in [1, {MAX_RECORDED_STEPS}] (an integer >= 1; more "
                 "recorded steps cost time and add nothing: the solver subdivides where it must)",
             )
-        _require(not _is_bool(self.shear_sign) and self.shear_sign in (1, -1),
+        require(not is_bool(self.shear_sign) and self.shear_sign in (1, -1),
                  f"shear_sign = {self.shear_sign!r} must be +1 or -1")
         if self.shear_ratio is not None:
-            if _is_bool(self.shear_ratio):
+            if is_bool(self.shear_ratio):
                 raise InputError(f"shear_ratio = {self.shear_ratio!r} is a bool, not a number")
             try:
                 value = float(self.shear_ratio)
             except (TypeError, ValueError, OverflowError):
                 raise InputError(f"shear_ratio = {self.shear_ratio!r} is not a number") from None
-            _require(math.isfinite(value) and value >= 0.0, f"shear_ratio dW/L = {value!r} must be >= 0")
+            require(math.isfinite(value) and value >= 0.0, f"shear_ratio dW/L = {value!r} must be >= 0")
             object.__setattr__(self, "shear_ratio", value)
 
     def resolved_shear_ratio(self, strip: Strip) -> float:
@@ -286,14 +252,14 @@ class LoadingProtocol:
         against the one the strip was built for (Strip.from_ratios): dL/L has one source."""
         design = strip.design_compression_ratio
         if design is not None:
-            _require(abs(design - self.compression_ratio) <= 1e-12 * design,
+            require(abs(design - self.compression_ratio) <= 1e-12 * design,
                      f"compression_ratio dL/L = {self.compression_ratio:g} of the loading protocol differs from the "
                      f"dL/L = {design:g} the strip was built for (Strip.from_ratios sets L = 75 mm / (1 - dL/L)); "
                      "give the same value to both, or build the strip with Strip(length=..., width=..., thickness=...)")
         limit = strip.shear_limit(self.compression_ratio * strip.length) / strip.length
         if self.shear_ratio is None:
             return limit
-        _require(
+        require(
             self.shear_ratio <= limit * (1.0 + 1e-12),
             f"shear_ratio dW/L = {self.shear_ratio:g} beyond the shear limit dW_max/L = {limit:.6g} "
             f"(Eq. B.1) for W/L = {strip.width_ratio:g}, dL/L = {self.compression_ratio:g}; allowed [0, {limit:.6g}]",

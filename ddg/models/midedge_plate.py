@@ -34,7 +34,8 @@ from ..energies.membrane import add_membrane_terms, face_membrane_matrices
 from ..energies.midedge_bending import ROLE_FIRST, ROLE_SECOND, add_midedge_terms, face_bending_matrices
 from ..energies.smoothed_membrane import add_smoothed_membrane_terms, node_patches, plane_stress_matrix, strain_maps
 from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, ghost_clamp_mesh
-from ..geometry.strip import InputError, Strip
+from ..limits import InputError
+from ..geometry.strip import Strip
 from .base import Evaluation
 from .plate import PlateModel
 

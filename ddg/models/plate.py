@@ -31,7 +31,8 @@ from ..energies.hinge_bending import add_hinge_terms, hinge_stiffness, triangle_
 from ..energies.stretch import add_edge_terms
 from ..geometry.centerline import first_mode_profile
 from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, structured_mesh
-from ..geometry.strip import InputError, Strip
+from ..limits import InputError
+from ..geometry.strip import Strip
 from .base import BandedModel, Evaluation
 
 

@@ -22,7 +22,7 @@ from ..geometry.centerline import Centerline
 from ..geometry.frames import rod_frames
 from ..geometry.strip import Strip
 from .base import BandedModel, Evaluation
-from .rod_assembly import PARTS, rod_energy, width_terms
+from .rod_assembly import PARTS, loops_of, rod_energy, width_terms
 
 __all__ = ["RodModel", "Evaluation"]
 
@@ -216,6 +216,11 @@ class RodModel(BandedModel):
         """The constants of rod_energy for the compiled Newton loop and corrector
         (ddg.solve.compiled_newton), or None where the model is assembled piece by piece."""
         return self.assembly_args()
+
+    def compiled_loops(self):
+        """The compiled Newton step and corrector bound to this model's energy
+        (ddg.solve.compiled_newton.CompiledLoops), for the solvers where compiled_energy() is not None."""
+        return loops_of(self.compiled_energy())
 
     def compiled_evaluation(self, parts, grad, band, frames, gradient: bool = True, hessian: bool = True) -> Evaluation:
         """The Evaluation of rod_energy's output (its parts by name, energy their sum)."""

@@ -11,7 +11,7 @@ compiled Newton loop (ddg.solve.compiled_newton) calls.
 
 The ribbons with width add their terms in the same call, chosen by the kind in `args`'s last entry
 (the width terms, `width_terms`; kind ROD adds nothing) and compiled apart per kind (ENERGIES, by
-ddg.solve.specialise: a model compiles only its own terms): the trapeze term's stretch-twist coupling
+ddg.assembly.specialise: a model compiles only its own terms): the trapeze term's stretch-twist coupling
 (ddg.energies.trapeze) on the stencils' chain rule with the stretch (rod_curvature.
 add_stretched_stencil_terms), Wunderlich's pairs of stencils (ddg.energies.wunderlich, their cross
 terms by rod_curvature.add_pair_cross_terms), and the cross-section as a field (ddg.energies.
@@ -44,7 +44,8 @@ from ..energies.stretch import add_edge_terms
 from ..energies.trapeze import trapeze_density
 from ..energies.wunderlich import wunderlich_pair_density
 from ..geometry.frames import rod_frames
-from ..solve.specialise import specialise
+from ..assembly.specialise import specialise
+from ..solve.compiled_newton import CompiledLoops, compile_loops
 
 #: The parts rod_energy returns, in its order (zero where the model has no such term).
 PARTS = ("stretching", "bending", "twisting", "sadowsky", "trapeze", "wunderlich", "cross_section",
@@ -181,7 +182,7 @@ def _cross_section(q, x, kappa_n, kappa_g, tau, first, second, rest_lengths, vor
 
 
 #: The kind of width terms a specialisation of the energy adds (bound per specialisation by
-#: ddg.solve.specialise: numba compiles only the branch it selects).
+#: ddg.assembly.specialise: numba compiles only the branch it selects).
 KIND = ROD
 
 
@@ -235,6 +236,15 @@ def _rod_energy(q, state, args, want_gradient, want_hessian, grad, band):
 #: each kind, so that a model compiles its own terms only.
 KIND_NAMES = {ROD: "rod", TRAPEZE: "trapeze", WUNDERLICH: "wunderlich", CROSS_SECTION: "cross_section"}
 ENERGIES = {kind: specialise(_rod_energy, name, KIND=kind) for kind, name in KIND_NAMES.items()}
+
+
+#: The compiled Newton step and pseudo-arclength corrector per kind, each bound to that kind's energy.
+LOOPS = {kind: compile_loops(name, ENERGIES[kind]) for kind, name in KIND_NAMES.items()}
+
+
+def loops_of(args) -> CompiledLoops:
+    """The compiled solver loops of a model's constants (RodModel.assembly_args)."""
+    return LOOPS[kind_of(args)]
 
 
 def kind_of(args) -> int:

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 from .io import atomic_path, atomic_write_text
 
 #: Nodes per cell of the supported cell types.

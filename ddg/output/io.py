@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 from ..analysis.observables import EXTRA_COLUMNS, PATH_COLUMNS
 
 

@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 from .io import atomic_path
 
 RENDER_EXTRA_MESSAGE = "install the 'render' extra: pip install ddg-strips[render]"

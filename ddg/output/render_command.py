@@ -33,7 +33,7 @@ def add_arguments(parser) -> None:
 def parse_steps(text, run) -> list[int] | None:
     """--steps as frame steps of `run` (None: the default choice); a one-line InputError naming the
     value and the recorded range otherwise."""
-    from ..geometry.strip import InputError
+    from ..limits import InputError
     from .render import check_steps
 
     if text is None:
@@ -58,7 +58,7 @@ def parse_steps(text, run) -> list[int] | None:
 
 def main(args) -> int:
     """Render; returns the exit code (0 drawn; 2 bad input, raised as InputError before any drawing)."""
-    from ..geometry.strip import InputError
+    from ..limits import InputError
     from .io import check_output_directory
     from .render import html_unavailable, import_pyvista, open_run, render_run
 

@@ -141,7 +141,7 @@ def width_warnings(summary: dict, error_map=None) -> list[str]:
         return []
     from ..advise import (Scene, basis_scenes, cross_validated_margin, fitting, load_map, map_file, map_scenes,
                           predictions)
-    from ..geometry.strip import InputError
+    from ..limits import InputError
 
     try:
         path, _ = map_file(error_map)

@@ -29,7 +29,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .extrapolation import ARCLENGTH_PREDICTOR_POINTS, lagrange_weights
-from . import compiled_newton
 from .newton import ROUNDOFF_STALL_FACTOR, settled
 from .state import State
 
@@ -137,7 +136,7 @@ class ArclengthTracer:
         return None
 
     def _correct_compiled(self, q, shear, compression, anchor, tangent, ds) -> State | None:
-        """_correct in one compiled call (ddg.solve.compiled_newton.arclength_correct) for a model
+        """_correct in one compiled call (the model's compiled_loops, ddg.solve.compiled_newton) for a model
         with a compiled energy; a singular bordered system ends the correction (None) instead of
         raising."""
         model = self.model
@@ -145,7 +144,8 @@ class ArclengthTracer:
         args = model.compiled_energy()
         base = model.clamp_values(compression, 0.0)
         floor = model.residual_floor()
-        (converged, q, shear, parts, grad, band, frames, pd, factor, corrections) = compiled_newton.arclength_correct(
+        correct = model.compiled_loops().arclength_correct
+        (converged, q, shear, parts, grad, band, frames, pd, factor, corrections) = correct(
             args, np.ascontiguousarray(q, dtype=float), model.committed_frames(), float(shear),
             (model.bandwidth + 1) * model.n_dof, base, self._shear_rate(compression), model.constrained,
             np.ascontiguousarray(anchor.q[free]), float(anchor.shear), tangent[0], float(tangent[1]), float(ds),

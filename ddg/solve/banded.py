@@ -6,14 +6,14 @@ a contiguous block of at most 11 DOFs: the Hessian has bandwidth 10 and Newton c
 The plate orders its nodes along the strip (ddg.geometry.plate_mesh), so its Hessian is
 banded too, with a bandwidth of about six times the nodes per column: for a strip a banded
 Cholesky beats general sparse factorisations (measured in benchmarks/plate_linear_algebra.py).
-The element kernels write into this storage directly (ddg.solve.band_scatter).
+The element kernels write into this storage directly (ddg.assembly.band_scatter).
 """
 from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as sla
 
-from .band_scatter import band_matvec
+from ..assembly.band_scatter import band_matvec
 
 
 class SymmetricBanded:

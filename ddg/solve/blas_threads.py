@@ -22,7 +22,7 @@ import os
 import threading
 from contextlib import contextmanager
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 
 __all__ = ["blas_threads", "requested_threads", "describe"]
 

@@ -1,7 +1,7 @@
 """Newton's method for a load step, and the pseudo-arclength corrector, in one compiled call (numba)
 for the models assembled by the rod family's compiled energy (ddg.models.rod_assembly.ENERGIES,
 one per kind of width terms). The loops call the energy directly, bound per kind when they are
-compiled (ddg.solve.specialise: numba does not cache a compiled function that takes another as an
+compiled (ddg.assembly.specialise: numba does not cache a compiled function that takes another as an
 argument), so each model compiles the loops with its own energy only.
 
 The algorithm is ddg.solve.newton's plain Newton (minimize=False) step for step: the same
@@ -20,16 +20,22 @@ frames it transports trial states' frames from.
 from __future__ import annotations
 
 import math
+from typing import Callable, NamedTuple
 
 import numpy as np
 from numba import njit
 
 from .band_ldlt import ldlt_unblocked, solve_transposed_1
-from .band_scatter import band_matvec
+from ..assembly.band_scatter import band_matvec
 from .banded import SymmetricBanded
-from ..models.rod_assembly import ENERGIES, KIND_NAMES, ROD, kind_of
 from .lapack import band_cholesky, band_cholesky_solve, band_lu_solve
-from .specialise import specialise
+from ..assembly.specialise import specialise
+
+def energy(q, state, args, want_gradient, want_hessian, grad, band):
+    """The compiled energy the loops call, with the signature of ddg.models.rod_assembly.rod_energy:
+    a name that compile_loops binds; the unbound loops are never compiled."""
+    raise NotImplementedError("the loops run as compiled by compile_loops(suffix, energy)")
+
 
 #: Outcomes (NewtonResult.message is written from them in ddg.solve.newton).
 (CONVERGED, ROUNDOFF, NON_FINITE, STALLED, NOT_CONTRACTING, LINE_SEARCH_FAILED, NO_PROGRESS, NO_CONVERGENCE,
@@ -358,18 +364,16 @@ def _arclength_correct(args, q, state, shear, band_size, clamp_base, clamp_rate,
     return False, q, shear, parts, grad, band, frames, pd, factor, max_iterations
 
 
-#: The compiled energy the loops call, bound per kind of width terms (ddg.solve.specialise): each
-#: model compiles the loops with its own energy only.
-energy = ENERGIES[ROD]
-_NEWTON = {kind: specialise(_newton_load_step, name, energy=ENERGIES[kind]) for kind, name in KIND_NAMES.items()}
-_ARCLENGTH = {kind: specialise(_arclength_correct, name, energy=ENERGIES[kind]) for kind, name in KIND_NAMES.items()}
+class CompiledLoops(NamedTuple):
+    """The two loops compiled with one energy: newton_load_step(args, q, state, ...) is
+    _newton_load_step, arclength_correct(args, q, state, shear, ...) is _arclength_correct."""
+    newton_load_step: Callable
+    arclength_correct: Callable
 
 
-def newton_load_step(args, *rest):
-    """_newton_load_step compiled with the energy of args' kind (the model's constants)."""
-    return _NEWTON[kind_of(args)](args, *rest)
-
-
-def arclength_correct(args, *rest):
-    """_arclength_correct compiled with the energy of args' kind (the model's constants)."""
-    return _ARCLENGTH[kind_of(args)](args, *rest)
+def compile_loops(suffix: str, energy) -> CompiledLoops:
+    """_newton_load_step and _arclength_correct bound to `energy` (a compiled function with the
+    signature of ddg.models.rod_assembly.rod_energy), cached apart under `suffix`; each compiles on
+    its first call."""
+    return CompiledLoops(specialise(_newton_load_step, suffix, energy=energy),
+                         specialise(_arclength_correct, suffix, energy=energy))

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 from .arclength import ArclengthOptions, ArclengthTracer
 from .extrapolation import LOAD_PREDICTOR_POINTS, extrapolate
 from .probe import SILENT, Probe

@@ -27,7 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..geometry.strip import InputError, LoadingProtocol, Strip
+from ..limits import InputError
+from ..geometry.strip import LoadingProtocol, Strip
 from .banded import SymmetricBanded
 from .newton import NewtonOptions, newton
 

@@ -12,37 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry.strip import InputError
+from ..limits import InputError, check_option  # noqa: F401  (check_option: options' fields)
 from . import compiled_newton
-
-
-def check_option(owner: str, name: str, value, kind: str, low=None, high=None, *, low_open: bool = False,
-                 allow_none: bool = False):
-    """One field of an options object: kind 'int', 'float' or 'bool', within [low, high] (low
-    excluded if low_open); a one-line InputError naming the value and the allowed range."""
-    if value is None and allow_none:
-        return None
-    where = f"{owner}({name}={value!r})"
-    lo = "(" if low_open else "["
-    span = f"{lo}{low:g}, {high:g}]" if low is not None and high is not None else ""
-    if kind == "bool":
-        if not isinstance(value, (bool, np.bool_)):
-            raise InputError(f"{where}: must be True or False")
-        return bool(value)
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InputError(f"{where}: must be {'an integer' if kind == 'int' else 'a number'} in {span}"
-                         + (" or None" if allow_none else ""))
-    if kind == "int":
-        if isinstance(value, (float, np.floating)) and not float(value).is_integer():
-            raise InputError(f"{where}: must be an integer in {span}")
-        value = int(value)
-    else:
-        value = float(value)
-        if not math.isfinite(value):
-            raise InputError(f"{where}: must be a finite number in {span}")
-    if (low is not None and (value <= low if low_open else value < low)) or (high is not None and value > high):
-        raise InputError(f"{where}: outside the allowed range {span}")
-    return value
 
 
 #: Descending from a saddle to a stable branch (minimize=True) slides along a soft, curved
@@ -173,7 +144,7 @@ def _compiled(model, q, options, evaluation):
     give_up = -1 if options.give_up_after is None else options.give_up_after
     limit = 0.0 if options.contraction_limit is None else options.contraction_limit
     (outcome, q_end, energy_end, parts, grad, band, frames, iterations, res, pd, factor, accepted, trials, ratio,
-     tiny) = compiled_newton.newton_load_step(
+     tiny) = model.compiled_loops().newton_load_step(
         args, np.ascontiguousarray(q, dtype=float), model.committed_frames(), ev.energy, np.zeros(0),
         ev.gradient, ev.hessian.band.reshape(-1), free.start, free.stop, model.residual_scale(),
         model.length_scale(), residual_tol, options.step_tol, noise, options.max_iterations,

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 
 DASK_EXTRA = "install the 'dask' extra: pip install ddg-strips[dask]"
 #: Seconds to wait for an existing scheduler to answer.

@@ -14,7 +14,7 @@ import json
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 
 PACKAGE = Path(__file__).resolve().parent.parent  # ddg/
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..geometry.strip import InputError
+from ..limits import InputError
 from .cache import Outcome
 
 #: The paper's widths (the FEM gold scenes): W/L = 1/20, 1/12, 1/6, 1/3, 1/2.
@@ -159,7 +159,7 @@ def checked_models(name: str, values) -> list[str]:
 
 def checked_ratios(name: str, values, high: float) -> list[float]:
     """Numbers in (0, high]; `name` may carry a symbol after the option ("--width-ratios W/L")."""
-    from ..analysis.centerline_approx import check_ratios
+    from ..limits import check_ratios
 
     return check_ratios(name, counted(name.split()[0], list_values(values)), 0.0, high)
 

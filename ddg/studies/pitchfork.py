@@ -15,7 +15,7 @@ from ..models.rod import RodModel
 from ..solve.continuation import ContinuationOptions, PathFollower, relax_from
 from ..solve.stability import lowest_modes
 from ..solve.state import Snapshot, State
-from .observables import observe
+from ..analysis.observables import observe
 
 
 def same_state_in_frames(model, q_from: np.ndarray, frames_from, q: np.ndarray, frames) -> np.ndarray:

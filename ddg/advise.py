@@ -72,6 +72,8 @@ from pathlib import Path
 
 from .limits import InputError
 from .geometry.strip import Strip
+from .models import registry
+from .models.names import MIDEDGE_PLATE
 
 ROOT = Path(__file__).resolve().parent.parent
 #: The committed error map (python -m validation.error_map --out data/error_map).
@@ -88,13 +90,13 @@ SAME = 1e-3
 #: Models the map holds that ddg does not run (information only).
 NOT_RUN = ("fem",)
 #: The plates: keyed by element size, not node count.
-PLATE_MODELS = ("plate", "plate-midedge")
+PLATE_MODELS = registry.names_in(registry.PLATES)
 #: The prediction rule of this module (docstring); summary.json's auto block names it.
 RULE = "v3"
 #: The Poisson ratio of every scene of the map (the FEM references and the runs are at nu = 0).
 MAP_POISSON_RATIO = 0.0
 #: Used only when the map has no runnable row at all: the mid-edge plate on 18 rows.
-FALLBACK_MODEL, FALLBACK_ROWS = "plate-midedge", 18
+FALLBACK_MODEL, FALLBACK_ROWS = MIDEDGE_PLATE, 18
 
 
 # ------------------------------------------------------------------------------------ input checks
@@ -644,7 +646,7 @@ def study_mesh(model: str, strip: Strip, rows: int):
     mid-edge plate."""
     from .geometry.plate_mesh import equilateral_mesh, ghost_clamp_mesh
 
-    if model == "plate-midedge":
+    if model == MIDEDGE_PLATE:
         return ghost_clamp_mesh(strip.length, strip.width, rows=rows)
     return equilateral_mesh(strip.length, strip.width, rows)
 

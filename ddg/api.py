@@ -16,6 +16,8 @@ import numpy as np
 from .analysis.observables import observe
 from .limits import InputError
 from .geometry.strip import LoadingProtocol, Strip
+from .models import registry
+from .models.names import MIDEDGE_PLATE, RIBBON, ROD
 from .models.ribbon import RIBBON_INITS
 from .protocol.after import BranchStep, Brackets, ThresholdStep
 from .protocol.driver import AfterStep, Loading, Run, execute
@@ -29,13 +31,10 @@ from .solve.probe import SILENT, Probe
 __all__ = ["simulate", "run_ribbon", "simulate_dynamic", "make_model", "SimulationResult", "RibbonResult",
            "DynamicResult"]
 
-#: ribbon: M not a multiple of 4, see RibbonModel
-#: Default resolution per model: rod and ribbons M nodes (the ribbons' M is not a multiple of 4, see
-#: ddg.models.ribbon), plates target triangles.
-DEFAULT_RESOLUTION = {"rod": 100, "plate": 2000, "plate-midedge": 2000, "ribbon": 101, "ribbon-sano-wada": 101,
-                      "ribbon-trapeze": 101, "ribbon-cross-section": 101, "ribbon-wunderlich": 101}
+#: Default resolution per model (ddg.models.registry): rod family M nodes, plates target triangles.
+DEFAULT_RESOLUTION = {name: entry.default_resolution for name, entry in registry.MODELS.items()}
 #: The models on the rod's centreline and frame (resolution = node count M).
-ROD_FAMILY = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section", "ribbon-wunderlich")
+ROD_FAMILY = registry.names_in(registry.ROD_FAMILY)
 
 
 #: Stations along the centerline exported per recorded step (centerline.csv).
@@ -52,24 +51,25 @@ def make_model(name: str, strip: Strip, resolution: int | None = None, mesh=None
     mesh (plate only): a PlateMesh, the path of a mesh file meshio reads, or "gmsh" for an
     unstructured gmsh mesh with about `resolution` triangles; default the structured mesh.
     """
-    cls = _model_class(name)
+    entry = registry.entry(name)
+    cls = entry.model_class
     resolution = check_resolution(name, resolution)
-    if membrane is not None and name != "plate-midedge":
-        raise InputError(f"membrane applies to the model 'plate-midedge' only, not {name!r}")
+    if membrane is not None and not entry.accepts(registry.MEMBRANE):
+        raise InputError(f"membrane applies to the model {_listed(registry.MEMBRANE)} only, not {name!r}")
     extra = {"membrane": membrane} if membrane is not None else {}
     if zeta is not None:
-        if name not in ("ribbon", "ribbon-wunderlich"):
-            raise InputError(f"zeta applies to the models 'ribbon' and 'ribbon-wunderlich' only, not {name!r}")
+        if not entry.accepts(registry.ZETA):
+            raise InputError(f"zeta applies to the models {_listed(registry.ZETA)} only, not {name!r}")
         if mesh is not None:
             raise InputError(f"a mesh is used by the plate models only, not {name!r}")
         return cls(strip, resolution, zeta=zeta)
     if mesh is None:
         return cls(strip, resolution, **extra)
-    if name not in ("plate", "plate-midedge"):
+    if not entry.accepts(registry.MESH):
         raise InputError(f"a mesh is used by the plate models only, not {name!r}")
     from .geometry.plate_mesh import PlateMesh
 
-    if name == "plate-midedge":
+    if not entry.accepts(registry.MESH_FILE):
         if not isinstance(mesh, PlateMesh):
             raise InputError(f"mesh = {mesh!r}: the mid-edge plate takes a PlateMesh from "
                              "ddg.geometry.plate_mesh.ghost_clamp_mesh (no mesh files)")
@@ -97,24 +97,18 @@ def _frame_writer(model, directory: Path):
     return FrameWriter(directory, cells, reference=flat, cell_type="triangle")
 
 
+def _listed(option: str) -> str:
+    """The models accepting `option`, quoted and joined as the error messages say them."""
+    return " and ".join(repr(name) for name in registry.accepting(option))
+
+
 def _model_class(name: str):
-    from .models.midedge_plate import MidedgePlateModel
-    from .models.plate import PlateModel
-    from .models.ribbon import RibbonModel
-    from .models.rod import RodModel
-
-    from .models.wide_ribbons import WIDE_RIBBONS
-
-    models = {"rod": RodModel, "plate": PlateModel, "plate-midedge": MidedgePlateModel, "ribbon": RibbonModel,
-              **WIDE_RIBBONS}
-    return models[check_model_name(name)]
+    return registry.entry(name).model_class
 
 
 def check_model_name(model) -> str:
     """model as one of the available names (a one-line InputError otherwise)."""
-    if not isinstance(model, str) or model not in DEFAULT_RESOLUTION:
-        raise InputError(f"model = {model!r} is not available; choose one of {sorted(DEFAULT_RESOLUTION)}")
-    return model
+    return registry.entry(model).name
 
 
 def check_resolution(model: str, resolution, strip: Strip | None = None, mesh=None) -> int:
@@ -140,7 +134,7 @@ def check_resolution(model: str, resolution, strip: Strip | None = None, mesh=No
         estimate = getattr(plate_mesh, "plate_memory_estimate_bytes", None)
         if estimate is not None:
             # the mid-edge plate: about twice the DOFs and twice the bandwidth of the paper's plate
-            factor = 4.0 if model == "plate-midedge" else 1.0
+            factor = 4.0 if model == MIDEDGE_PLATE else 1.0
             check_memory("resolution (target triangle count)", value,
                          factor * estimate(strip.length, strip.width, value))
     return value
@@ -216,7 +210,7 @@ def _checked_flags(**flags) -> None:
 def simulate(
     strip: Strip,
     protocol: LoadingProtocol,
-    model: str = "rod",
+    model: str = ROD,
     resolution: int | None = None,
     out: str | Path | None = None,
     options: ContinuationOptions | None = None,
@@ -297,22 +291,22 @@ def simulate(
     if branches is not None and not isinstance(branches, (bool, np.bool_)):
         raise InputError(f"branches = {branches!r} must be True, False or None")
     resolution = check_resolution(model, resolution, strip, mesh)
-    if zeta is not None and model not in ("ribbon", "ribbon-wunderlich"):
-        raise InputError(f"zeta applies to the models 'ribbon' and 'ribbon-wunderlich' only, not {model!r}")
+    if zeta is not None and not registry.entry(model).accepts(registry.ZETA):
+        raise InputError(f"zeta applies to the models {_listed(registry.ZETA)} only, not {model!r}")
     protocol.resolved_shear_ratio(strip)
     if out is not None:
         from .output.io import check_output_directory
 
         check_output_directory(out)
     if solver == "dynamic":
-        if model != "rod":
-            raise InputError(f"solver = 'dynamic' is available for model 'rod' only, not {model!r}")
+        if model != ROD:
+            raise InputError(f"solver = 'dynamic' is available for model {ROD!r} only, not {model!r}")
         if frames or mesh is not None:
             raise InputError("frames and mesh are options of the static solver; drop them or use solver='static'")
         return simulate_dynamic(strip, protocol, resolution, dynamic_options, out=out)
     if dynamic_options is not None:
         raise InputError("dynamic_options apply to solver='dynamic' only")
-    branches = (model not in ("plate", "plate-midedge")) if branches is None else bool(branches)
+    branches = (not registry.entry(model).resolves_width) if branches is None else bool(branches)
     instance = make_model(model, strip, resolution, mesh, zeta=zeta, membrane=membrane)
     if frames and out is None:
         raise InputError("frames=True needs an output directory (out)")
@@ -397,7 +391,7 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
         raise InputError(f"ribbon init = {init!r} is not available; choose one of {list(RIBBON_INITS)}")
     if not isinstance(strip, Strip) or not isinstance(protocol, LoadingProtocol):
         raise InputError("run_ribbon needs a ddg.Strip and a ddg.LoadingProtocol")
-    resolution = check_resolution("ribbon", resolution)
+    resolution = check_resolution(RIBBON, resolution)
     _checked_flags(centerline=centerline)
     if out is not None:
         from .output.io import check_output_directory
@@ -405,10 +399,10 @@ def run_ribbon(strip: Strip, protocol: LoadingProtocol, init: str = "direct", ze
         check_output_directory(out)
     options = _checked_options(options)
     ribbon = RibbonModel(strip, resolution, zeta=zeta)
-    stepper = RodDrivenStepper(ribbon, RodModel(strip, resolution), options, probe) if init == "rod" \
+    stepper = RodDrivenStepper(ribbon, RodModel(strip, resolution), options, probe) if init == ROD \
         else StaticStepper(ribbon, options, folds=False, probe=probe)
     L = strip.length
-    return _static_run("ribbon", ribbon, strip, protocol, resolution, options, out, progress, thresholds, False,
+    return _static_run(RIBBON, ribbon, strip, protocol, resolution, options, out, progress, thresholds, False,
                        summary_extra={"ribbon_init": init, "zeta": ribbon.zeta, "zeta_over_L": ribbon.zeta / L},
                        stepper=stepper, result=RibbonResult, probe=probe, centerline=centerline)
 
@@ -435,7 +429,7 @@ def simulate_dynamic(strip: Strip, protocol: LoadingProtocol, resolution: int = 
     options = dataclasses.replace(options) if options is not None else DynamicOptions()  # re-validated
     options.check_scene(strip, protocol)
     model = RodModel(strip, resolution)
-    summary = base_summary("rod", strip, protocol, resolution, model)
+    summary = base_summary(ROD, strip, protocol, resolution, model)
     summary["solver"] = "implicit-euler"
     summary["scene"]["dynamics"] = dataclasses.asdict(options)
     folder = _open_folder(out, summary)
@@ -460,11 +454,11 @@ def run_candidate(strip: Strip, protocol: LoadingProtocol, model: str, resolutio
     (ddg.advise.study_mesh); no branch tracing unless asked; centerline as in simulate."""
     from .advise import study_mesh
 
-    if model in ("plate", "plate-midedge"):
+    if registry.entry(model).resolves_width:
         return simulate(strip, protocol, model=model, mesh=study_mesh(model, strip, resolution), out=out,
                         options=options, progress=progress, thresholds=thresholds, branches=branches, probe=probe,
                         centerline=centerline)
-    if model == "ribbon":
+    if model == RIBBON:
         return run_ribbon(strip, protocol, "direct", None, resolution, out=out, options=options,
                           thresholds=thresholds, progress=progress, probe=probe, centerline=centerline)
     return simulate(strip, protocol, model=model, resolution=resolution, out=out, options=options, progress=progress,

@@ -17,14 +17,14 @@ from pathlib import Path
 from .cli_parser import EXIT_BAD_INPUT, OneLineParser
 from .limits import InputError
 from .geometry.strip import LoadingProtocol, Strip
+from .models import registry
 
 EXIT_NOT_CONVERGED = 3
 EXIT_INTERNAL = 1
 
 
-#: --model choices of simulate: the plates, the rod and the ribbons (ddg.api.DEFAULT_RESOLUTION).
-MODEL_CHOICES = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", "ribbon-trapeze",
-                 "ribbon-cross-section", "ribbon-wunderlich")
+#: --model choices of simulate: every model of the registry (ddg.models.registry).
+MODEL_CHOICES = registry.NAMES
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -20,10 +20,14 @@ import time
 
 import numpy as np
 
+from .models import registry
+from .models.names import (CROSS_SECTION_RIBBON, MIDEDGE_PLATE, PLATE, RIBBON, ROD, SANO_WADA_RIBBON, TRAPEZE_RIBBON,
+                           WUNDERLICH_RIBBON)
+
 #: The rod family's parts: their compiled energy and loops are compiled per kind of width terms
 #: (ddg.models.rod_assembly.ENERGIES); the plates share nothing with them.
-ROD_FAMILY = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section", "ribbon-wunderlich")
-PLATES = ("plate", "plate-midedge")
+ROD_FAMILY = registry.names_in(registry.ROD_FAMILY)
+PLATES = registry.names_in(registry.PLATES)
 PARTS = ROD_FAMILY + PLATES + ("arrays",)
 
 
@@ -43,21 +47,16 @@ def _evaluate_every_way(model, rng) -> None:
 
 def _rod_family(name: str, rng) -> None:
     """The model's compiled energy, then the compiled Newton load step and corrector on it."""
-    from .models.ribbon import RibbonModel
-    from .models.rod import RodModel
-    from .models.wide_ribbons import CrossSectionRibbon, SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon
     from .solve.arclength import ArclengthTracer
     from .solve.newton import NewtonOptions, newton
     from .solve.state import State
 
     strip = _strip()
-    build = {"rod": lambda: RodModel(strip, 9), "ribbon": lambda: RibbonModel(strip, 9),
-             "ribbon-sano-wada": lambda: SanoWadaRibbon(strip, 9), "ribbon-trapeze": lambda: TrapezeRibbon(strip, 9),
-             "ribbon-cross-section": lambda: CrossSectionRibbon(strip, 9),
-             "ribbon-wunderlich": lambda: WunderlichRibbon(strip, 9, zeta=0.01 * strip.length)}
-    model = build[name]()
+    entry = registry.MODELS[name]
+    extra = {"zeta": 0.01 * strip.length} if name == WUNDERLICH_RIBBON else {}
+    model = entry.model_class(strip, 9, **extra)
     _evaluate_every_way(model, rng)
-    model = build[name]()
+    model = entry.model_class(strip, 9, **extra)
     compression = 0.3 * strip.length
     q = model.apply_clamps(model.buckled_guess(compression), compression, 0.0)
     result = newton(model, q, NewtonOptions())
@@ -67,15 +66,15 @@ def _rod_family(name: str, rng) -> None:
 
 def _plate(name: str, rng) -> None:
     from .energies.hinge_bending import hinge_bending_energy, triangle_normals
-    from .models.midedge_plate import MEMBRANES, MidedgePlateModel
-    from .models.plate import PlateModel
+    from .models.midedge_plate import MEMBRANES
 
     strip = _strip()
-    if name == "plate-midedge":
+    model_class = registry.MODELS[name].model_class
+    if name == MIDEDGE_PLATE:
         for membrane in MEMBRANES:
-            _evaluate_every_way(MidedgePlateModel(strip, 40, membrane=membrane), rng)
+            _evaluate_every_way(model_class(strip, 40, membrane=membrane), rng)
         return
-    plate = PlateModel(strip, 40)
+    plate = model_class(strip, 40)
     _evaluate_every_way(plate, rng)
     xp = plate.reset().reshape(-1, 3)
     triangle_normals(xp, plate.mesh.triangles)
@@ -144,12 +143,11 @@ def _worker(part: str) -> tuple[str, float]:
 
 
 #: The parts whose kernels are the same (the rod's kind of width terms): warmed in one process, in order.
-SAME_KERNELS = ("rod", "ribbon", "ribbon-sano-wada")
+SAME_KERNELS = (ROD, RIBBON, SANO_WADA_RIBBON)
 #: The order in which parts are handed to the workers: the longest first, then the parts that share
 #: none of its kernels (the plates, the array interfaces), so that the other rod-family parts start
 #: once it has cached the kernels they share with it (frames, stencils, stretched chain rule).
-WARM_ORDER = ("ribbon-cross-section", "plate-midedge", "plate", "arrays", "rod", "ribbon-wunderlich",
-              "ribbon-trapeze")
+WARM_ORDER = (CROSS_SECTION_RIBBON, MIDEDGE_PLATE, PLATE, "arrays", ROD, WUNDERLICH_RIBBON, TRAPEZE_RIBBON)
 
 
 def compile_in_parallel(parts=None, jobs: int | None = None) -> dict:
@@ -167,7 +165,7 @@ def compile_in_parallel(parts=None, jobs: int | None = None) -> dict:
     same = [p for p in SAME_KERNELS if p in parts]
     queues = {p: [p] for p in parts if p not in SAME_KERNELS}
     if same:
-        queues["rod"] = same
+        queues[ROD] = same
     order = sorted(queues, key=lambda p: WARM_ORDER.index(p) if p in WARM_ORDER else len(WARM_ORDER))
     timings = {}
     with cf.ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as pool:

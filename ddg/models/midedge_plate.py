@@ -38,6 +38,7 @@ from ..limits import InputError
 from ..geometry.strip import Strip
 from .base import Evaluation
 from .plate import PlateModel
+from .names import MIDEDGE_PLATE
 
 
 #: Membrane discretisations: "psri", alpha = min(1, b^2 / h^2) of the constant-strain triangles and
@@ -51,7 +52,7 @@ class MidedgePlateModel(PlateModel):
     """The mid-edge plate of a Strip on a ghost-clamp structured mesh of ~`triangles` triangles
     (or `rows` rows across W, or a given ghost_clamp_mesh)."""
 
-    name = "plate-midedge"
+    name = MIDEDGE_PLATE
 
     def __init__(self, strip: Strip, triangles: int = DEFAULT_TRIANGLES, *, rows: int | None = None,
                  mesh: PlateMesh | None = None, membrane: str = "psri"):

@@ -34,13 +34,14 @@ from ..geometry.plate_mesh import DEFAULT_TRIANGLES, PlateMesh, structured_mesh
 from ..limits import InputError
 from ..geometry.strip import Strip
 from .base import BandedModel, Evaluation
+from .names import PLATE
 
 
 
 class PlateModel(BandedModel):
     """The DEP of a Strip on a triangle mesh (structured with ~`triangles` triangles by default)."""
 
-    name = "plate"
+    name = PLATE
 
     def __init__(self, strip: Strip, triangles: int = DEFAULT_TRIANGLES, *, mesh: PlateMesh | None = None):
         self.strip = strip

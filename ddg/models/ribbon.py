@@ -14,13 +14,14 @@ import numpy as np
 from ..energies.sadowsky import check_zeta, sadowsky_density
 from ..geometry.strip import Strip
 from .rod import RodModel
+from .names import RIBBON, ROD
 
 __all__ = ["RibbonModel", "DEFAULT_ZETA_OVER_L", "RIBBON_INITS"]
 
 #: How a ribbon run is started (ddg.protocol): "direct" follows the ribbon itself from the flat
 #: strip (the paper's Direct-Sadowsky); "rod" relaxes each recorded state of the rod under the
 #: ribbon's energy (DAR-Sadowsky).
-RIBBON_INITS = ("direct", "rod")
+RIBBON_INITS = ("direct", ROD)
 
 #: Default regularisation length zeta / L of Eq. (A.5). At W/L = 1/20, dL/L = 1/2, M = 101 the
 #: shear path (H_mid up to dW/L = 0.5, direct and rod-initialised) differs from zeta / L = 1e8 by
@@ -39,7 +40,7 @@ class RibbonModel(RodModel):
     asymmetric state (2e-4 L at dW/L = 0.02). The default resolution is 101.
     """
 
-    name = "ribbon"
+    name = RIBBON
 
     def __init__(self, strip: Strip, nodes: int = 100, zeta: float | None = None):
         super().__init__(strip, nodes)

@@ -23,13 +23,14 @@ from ..geometry.frames import rod_frames
 from ..geometry.strip import Strip
 from .base import BandedModel, Evaluation
 from .rod_assembly import PARTS, loops_of, rod_energy, width_terms
+from .names import ROD
 
 __all__ = ["RodModel", "Evaluation"]
 
 class RodModel(BandedModel):
     """The DAR of a Strip on a Centerline of M nodes, with its reference-frame state."""
 
-    name = "rod"
+    name = ROD
     bandwidth = 10
     edge_fields = 0  # DOFs per edge beyond the twist angle (the rod has none)
 

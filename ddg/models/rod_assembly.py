@@ -234,7 +234,7 @@ def _rod_energy(q, state, args, want_gradient, want_hessian, grad, band):
 
 #: The compiled energy per kind of width terms: one implementation (_rod_energy), compiled apart for
 #: each kind, so that a model compiles its own terms only.
-KIND_NAMES = {ROD: "rod", TRAPEZE: "trapeze", WUNDERLICH: "wunderlich", CROSS_SECTION: "cross_section"}
+KIND_NAMES = {ROD: "plain", TRAPEZE: "trapeze", WUNDERLICH: "wunderlich", CROSS_SECTION: "cross_section"}
 ENERGIES = {kind: specialise(_rod_energy, name, KIND=kind) for kind, name in KIND_NAMES.items()}
 
 

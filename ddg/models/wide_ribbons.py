@@ -44,6 +44,7 @@ from ..geometry.strip import Strip
 from .ribbon import RibbonModel
 from .rod import RodModel
 from .rod_assembly import CROSS_SECTION, PARTS, TRAPEZE, WUNDERLICH, width_terms
+from .names import CROSS_SECTION_RIBBON, SANO_WADA_RIBBON, TRAPEZE_RIBBON, WUNDERLICH_RIBBON
 
 __all__ = ["SanoWadaRibbon", "TrapezeRibbon", "CrossSectionRibbon", "WunderlichRibbon", "sano_wada_zeta",
            "WIDE_RIBBONS"]
@@ -73,7 +74,7 @@ def sano_wada_zeta(strip: Strip) -> float:
 class SanoWadaRibbon(RibbonModel):
     """Eq. (A.5) with zeta from the strip: sqrt((1 - nu) / 60) W^2 / b (Sano and Wada 2019)."""
 
-    name = "ribbon-sano-wada"
+    name = SANO_WADA_RIBBON
 
     def __init__(self, strip: Strip, nodes: int = 101):
         super().__init__(strip, nodes, zeta=sano_wada_zeta(strip))
@@ -82,7 +83,7 @@ class SanoWadaRibbon(RibbonModel):
 class TrapezeRibbon(RodModel):
     """The DAR plus the trapeze term (ddg.energies.trapeze): the edges' stretching under twist."""
 
-    name = "ribbon-trapeze"
+    name = TRAPEZE_RIBBON
 
     def __init__(self, strip: Strip, nodes: int = 101):
         super().__init__(strip, nodes)
@@ -106,7 +107,7 @@ class CrossSectionRibbon(RodModel):
     """The DAR plus its cross-section as a field (ddg.energies.cross_section, Eqs. X, X' and V):
     `modes` DOFs per edge after the twist angle (node_stride 4 + modes), zero on the clamped edges."""
 
-    name = "ribbon-cross-section"
+    name = CROSS_SECTION_RIBBON
     edge_fields = 2
 
     def __init__(self, strip: Strip, nodes: int = 101, modes: int | None = None):
@@ -247,7 +248,7 @@ class WunderlichRibbon(RibbonModel):
     """Eq. (A.2) regularised as (A.5): the Sadowsky ribbon (RibbonModel) with GJ from the strip,
     each node's density times the mean ruling factor g(W eta') of its pairs of stencils."""
 
-    name = "ribbon-wunderlich"
+    name = WUNDERLICH_RIBBON
     bandwidth = 14  # a pair of stencils spans 15 DOFs
 
     def __init__(self, strip: Strip, nodes: int = 101, zeta: float | None = None):

@@ -26,13 +26,13 @@ from __future__ import annotations
 import warnings
 
 from ..analysis.observables import RESOLVED_STRAIN, RESOLVED_TURN_ANGLE_DEG
+from ..models import registry
 from ..models.wide_ribbons import LONG_WAVELENGTH_LIMIT
 
 #: dW1/L error + reference error bar (units of L) above which the map does not show a 1D model good enough.
 WIDTH_TOLERANCE = 0.01
 #: The models without a resolved width (ddg.api.ROD_FAMILY).
-ONE_D_MODELS = ("rod", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section",
-                "ribbon-wunderlich")
+ONE_D_MODELS = registry.names_in(registry.ROD_FAMILY)
 
 
 class ValidityWarning(UserWarning):

@@ -5,6 +5,7 @@ from __future__ import annotations
 from ..analysis.centerline_approx import (PAPER_SHEAR_RATIOS, PAPER_WIDTH_RATIOS, centerline_error_field,
                                           edge_reconstruction)
 from ..geometry.strip import Strip
+from ..models.names import PLATE
 from ..solve.continuation import ContinuationFailure
 from ..solve.state import phase_label
 from .curvature_studies import states_at_shears
@@ -26,7 +27,7 @@ def centerline_error_study(width_ratios=PAPER_WIDTH_RATIOS, shear_ratios=PAPER_S
         done = set()
         message = ""
         try:
-            for model, state in states_at_shears("plate", strip, compression_ratio, wanted, triangles,
+            for model, state in states_at_shears(PLATE, strip, compression_ratio, wanted, triangles,
                                                  max_step=max_step, options=options):
                 field = centerline_error_field(model, state.q)
                 edges = edge_reconstruction(model, state.q)

@@ -14,6 +14,7 @@ from ..analysis.curvatures import CURVATURE_COLUMNS, inflection_jumps, plate_cur
 from ..api import make_model
 from ..geometry.strip import Strip
 from ..limits import InputError
+from ..models.names import PLATE, RIBBON, ROD
 from ..models.ribbon import RIBBON_INITS, RibbonModel
 from ..models.rod import RodModel
 from ..output.io import atomic_write_text
@@ -52,12 +53,12 @@ def states_at_shears(model_name: str, strip, compression_ratio: float, shear_rat
     options = options or ContinuationOptions()
     L = strip.length
     relax = None
-    if model_name == "ribbon":
+    if model_name == RIBBON:
         if ribbon_init not in RIBBON_INITS:
             raise InputError(f"ribbon init = {ribbon_init!r} is not available; choose one of {list(RIBBON_INITS)}")
         ribbon = RibbonModel(strip, 101 if resolution is None else resolution, zeta=zeta)
-        driver = RodModel(strip, ribbon.nodes) if ribbon_init == "rod" else ribbon
-        if ribbon_init == "rod":
+        driver = RodModel(strip, ribbon.nodes) if ribbon_init == ROD else ribbon
+        if ribbon_init == ROD:
             relax = lambda state: relax_from(ribbon, driver, state, options)  # noqa: E731
     else:
         driver = make_model(model_name, strip, resolution, mesh)
@@ -94,7 +95,7 @@ def inflection_twist_study(width_ratios=(1 / 20, 1 / 6), slendernesses=(300.0, 6
     for ratio in width_ratios:
         for slenderness in slendernesses:
             strip = Strip.from_ratios(ratio, compression_ratio, slenderness)
-            ((model, state),) = list(states_at_shears("plate", strip, compression_ratio, [shear_ratio], triangles,
+            ((model, state),) = list(states_at_shears(PLATE, strip, compression_ratio, [shear_ratio], triangles,
                                                       max_step=max_step, options=options))
             profile = plate_curvatures(model, state.q)
             jumps = inflection_jumps(profile)

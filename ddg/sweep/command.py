@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 
+from ..models.names import ROD
 from . import cluster
 from .run import PAPER_WIDTHS
 
@@ -23,7 +24,7 @@ OPTION_NAMES = {"models": "--model", "width_ratios": "--width-ratios W/L",
 
 def add_arguments(parser) -> None:
     """The sweep command's options (lists: comma- or space-separated)."""
-    parser.add_argument("--model", nargs="+", default=["rod"], metavar="MODEL",
+    parser.add_argument("--model", nargs="+", default=[ROD], metavar="MODEL",
                         help="rod (default), plate, ribbon; several allowed")
     parser.add_argument("--width-ratios", nargs="+", default=[DEFAULT_WIDTHS], metavar="W/L",
                         help="W/L values, comma- or space-separated as every list here (default 1/20, 1/12, 1/6, "

@@ -15,11 +15,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ..limits import InputError
+from ..models import registry
 
 PACKAGE = Path(__file__).resolve().parent.parent  # ddg/
 
-MODELS = ("rod", "plate", "plate-midedge", "ribbon", "ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section",
-          "ribbon-wunderlich")
+MODELS = registry.NAMES
 
 #: Modules of this package that schedule runs and present results but take no part in computing
 #: one: editing them keeps every cached run (a new module is hashed until it is listed here).
@@ -106,7 +106,7 @@ def _code_version(package: Path) -> str:
 def estimated_cost(spec: RunSpec) -> float:
     """Rough relative cost of a run, for ordering (the plate's path grows about linearly with its
     triangles, 2000 triangles ~ 20 rods of 100 nodes)."""
-    if spec.model in ("plate", "plate-midedge"):
+    if registry.MODELS[spec.model].resolves_width:
         return (spec.resolution or 2000) / 100.0
     return (spec.resolution or 100) / 100.0
 

@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..limits import InputError
+from ..models.names import ROD
 from .cache import Outcome
 
 #: The paper's widths (the FEM gold scenes): W/L = 1/20, 1/12, 1/6, 1/3, 1/2.
@@ -65,7 +66,7 @@ class SweepResult:
         return require_pandas("result.rows gives the same table as dicts").DataFrame(self.rows)
 
 
-def run_sweep(models=("rod",), width_ratios=PAPER_WIDTHS, compression_ratios=(0.5, 0.25), slendernesses=None,
+def run_sweep(models=(ROD,), width_ratios=PAPER_WIDTHS, compression_ratios=(0.5, 0.25), slendernesses=None,
               resolutions=None, *, out="out/sweep", compression_steps: int = 40, shear_steps: int = 120,
               workers: int | None = None, scheduler: str | None = None, retries: int = 2, progress: bool = False,
               figure: bool = True) -> SweepResult:

@@ -20,6 +20,7 @@ import traceback
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from ..models.names import RIBBON
 from ..output.io import atomic_write_text, read_numeric_rows
 from .grid import RunSpec, code_version
 
@@ -81,7 +82,7 @@ def execute_one(spec: RunSpec, directory: str) -> dict:
         t0 = time.perf_counter()
         try:
             strip, protocol = spec.strip(), spec.protocol()
-            if spec.model == "ribbon":  # started from the flat strip, as `python -m ddg simulate --model ribbon`
+            if spec.model == RIBBON:  # started from the flat strip, as `python -m ddg simulate --model ribbon`
                 ddg.run_ribbon(strip, protocol, "direct", None, spec.resolution, out=directory,
                                thresholds=spec.thresholds)
             else:

@@ -81,7 +81,7 @@ class Strip:
         object.__setattr__(self, "poisson_ratio", nu)
         check_within("length L", self.length, *LENGTH_RANGE, " m", "the scene is scale-free: give L in metres")
         check_within("young_modulus E", self.young_modulus, *YOUNG_MODULUS_RANGE, " Pa",
-                "from soft gels to above diamond; the geometry does not depend on E")
+                     "from soft gels to above diamond; the geometry does not depend on E")
         check_within("density", self.density, *DENSITY_RANGE, " kg/m^3", "used by the dynamic solver")
         require(
             self.width <= self.length,
@@ -92,7 +92,7 @@ class Strip:
             f"thickness b = {self.thickness:g} m must be smaller than width W = {self.width:g} m (0 < b < W)",
         )
         check_within("slenderness L/b", self.length / self.thickness, *SLENDERNESS_RANGE, "",
-                "a thin strip (b << L) whose stretching and bending stiffnesses stay within round-off of each other")
+                     "a thin strip (b << L) whose stretching and bending stiffnesses stay within round-off of each other")
 
     @classmethod
     def from_ratios(

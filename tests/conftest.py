@@ -14,7 +14,7 @@ def pytest_configure(config):
 
 @pytest.fixture(scope="session")
 def plate_sixth_fine():
-    """The plate of the clamp-force comparisons with the FEM (tests/test_shear_force.py; W/L = 1/6,
+    """The plate of the clamp-force comparisons with the FEM (tests/ddg/models/test_shear_force.py; W/L = 1/6,
     dL/L = 1/2) on the 5740-triangle mesh their measured figures and bounds refer to, with the quick
     shear sampling (60 steps): about 2 minutes on 2 cores, run once."""
     import ddg

@@ -23,7 +23,7 @@ BLOCK = ("import runpy, sys\n"
     ("meshio", ["ddg", "simulate", "--frames", "--out", "{tmp}/f"], "io"),
     ("jinja2", ["validation", "report", "--quick", "--out", "{tmp}/r"], "report"),
     ("matplotlib", ["validation", "report", "--quick", "--out", "{tmp}/r"], "report"),
-])   # render (pyvista) and dask: tests/test_render.py and tests/test_sweep.py
+])   # render (pyvista) and dask: tests/ddg/output/test_render.py and tests/ddg/sweep/test_sweep.py
 def test_a_missing_extra_is_named_in_one_line_before_any_work(blocked, argv, extra, tmp_path):
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     done = subprocess.run([sys.executable, "-c", BLOCK, blocked, *argv], cwd=ROOT, capture_output=True, text=True,

@@ -1,7 +1,7 @@
 """The README is what a newcomer reads first (issue 33 item 4): under 150 lines, its two commands the
 ones CI runs, every link resolving to a file of the repository, the manual's pages linked, and its
 sentence on the benchmark table computed from data/benchmark/benchmark.csv (the table itself:
-tests/test_benchmark_table.py)."""
+tests/validation/test_benchmark_table.py)."""
 import csv
 import re
 from pathlib import Path
@@ -50,7 +50,7 @@ def test_the_readme_sentence_on_the_benchmark_table_is_computed_from_it():
     bar of at most LIMIT L, the claims' rule): on N of its 20 thresholds, both at S of the ten
     scenes; the other U (combined error bars P-Q L) are undecided; the rod's dW1/L stays at D-E while
     the FEM's falls to F-G at W/L = 1/2": each figure recomputed from benchmark.csv, rounded as the
-    table rounds. Decided as tests/test_midedge_studies.py decides (assert_agreement_where_decided):
+    table rounds. Decided as tests/validation/test_midedge_studies.py decides (assert_agreement_where_decided):
     the sum of the mid-edge and FEM error bars at most the error-bar limit of the report's threshold
     claims (validation.claims), so an entry whose bars are too wide to tell is not counted as
     agreeing."""

@@ -66,7 +66,7 @@ def test_the_manifest_check_has_teeth(tmp_path, monkeypatch):
     """A stale or unreferenced entry fails: the checks above are not vacuous."""
     fake = tmp_path / "large_files.txt"
     monkeypatch.setattr(sys.modules[__name__], "MANIFEST", fake)
-    fake.write_text("validation/results/quick/index.html  tests/test_report_html.py  no-such-text\n")
+    fake.write_text("validation/results/quick/index.html  tests/validation/test_report_html.py  no-such-text\n")
     with pytest.raises(AssertionError, match="does not mention"):
         test_every_manifest_entry_is_a_large_tracked_file_its_reader_reads()
     fake.write_text("README.md  -\n")

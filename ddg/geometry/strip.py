@@ -92,7 +92,8 @@ class Strip:
             f"thickness b = {self.thickness:g} m must be smaller than width W = {self.width:g} m (0 < b < W)",
         )
         check_within("slenderness L/b", self.length / self.thickness, *SLENDERNESS_RANGE, "",
-                     "a thin strip (b << L) whose stretching and bending stiffnesses stay within round-off of each other")
+                     "a thin strip (b << L) whose stretching and bending stiffnesses stay within round-off "
+                     "of each other")
 
     @classmethod
     def from_ratios(

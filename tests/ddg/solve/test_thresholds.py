@@ -193,7 +193,7 @@ def test_dW2_at_a_fold_is_the_fold_itself_and_lies_in_the_bisections_bracket(nar
     the turn of dW along the branch (the fold the path snaps at) is where S becomes stable: the
     fold's dW2 equals dW2_S_stable (measured 2e-7 apart at M = 100, located independently: a
     parabola's vertex on US against a sign change of lambda_min on S, bracket 1e-3; bound 1e-6, five
-    times that; at M = 400 they differ by 2.3e-6, tests/test_branches.py). Bisection on
+    times that; at M = 400 they differ by 2.3e-6, tests/ddg/solve/test_branches.py). Bisection on
     the phase (the fallback) lands within its 1e-3 bracket above it; the fold costs a fraction of
     its iterations (measured 110 against 364 at M = 100)."""
     import ddg.solve.thresholds as thresholds

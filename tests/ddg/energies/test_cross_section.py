@@ -149,7 +149,7 @@ def test_straight_cross_section_is_the_trapeze_ribbon(nu):
 def test_untwisted_strip_keeps_a_straight_cross_section_for_nu_zero():
     """tau = 0, nu = 0: c = 0 is the minimum of the modes' energy at any eps and kappa (the centroid
     convention leaves no eps kappa c coupling), with zero energy and zero force on the modes: the
-    compressed strip is the rod and the elastica (tests/test_wide_ribbons.py runs it)."""
+    compressed strip is the rod and the elastica (tests/ddg/models/test_wide_ribbons.py runs it)."""
     shape = CrossSectionModes(0.05, 1e-3, 1e9, 0.0, 2)
     kappa = np.linspace(-40.0, 40.0, 9)
     eps, c, relieved = local_optimum(kappa, np.zeros_like(kappa), shape)

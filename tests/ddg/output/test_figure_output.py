@@ -10,7 +10,7 @@ pytest.importorskip("matplotlib")
 
 from ddg.output.io import FIGURE_METADATA, figure_bytes, save_figure  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 FORMATS = tuple(FIGURE_METADATA)
 
 

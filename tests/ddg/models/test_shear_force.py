@@ -23,7 +23,7 @@ import pytest
 import ddg
 from ddg.output.io import StoredRun
 
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[3] / "data"
 GOLD = DATA / "fem_gold" / "dL0.5_W0.1667"
 DEP = DATA / "fem_dep" / "dL0.5_W0.1667_N90"
 FINE = DATA / "fem_fine" / "dL0.5_W0.1667_N90"   # the nu = 0 shell on DEP's mesh

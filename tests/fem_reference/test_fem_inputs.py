@@ -101,7 +101,7 @@ def test_mesh_refused_by_its_memory_estimate(no_fem, capsys):
 
 def test_unknown_counts_and_estimates():
     """MeshSpec.n_dof is the Naghdi discretisation's count (as NaghdiStrip reports it: 24 x 10 in
-    tests/test_fem_reference.py, 60 x 10 and 120 x 20 in fem_reference/README.md); the gold and
+    tests/fem_reference/test_fem_reference.py, 60 x 10 and 120 x 20 in fem_reference/README.md); the gold and
     default meshes fit a 8 GiB budget, the largest allowed mesh of the widest strip does not."""
     from fem_reference.mesh import MeshSpec
 
@@ -315,7 +315,7 @@ def test_module_entry_point_one_line_and_no_fem_import(tmp_path):
     code = ("import sys; from fem_reference.cli import main; rc = main(sys.argv[1:]); "
             "print('dolfinx' in sys.modules, 'gmsh' in sys.modules); raise SystemExit(rc)")
     proc = subprocess.run([sys.executable, "-c", code, "simulate", *SCENE, "--resolution", "100000000"],
-                          capture_output=True, text=True, cwd=Path(__file__).resolve().parents[1], timeout=120)
+                          capture_output=True, text=True, cwd=Path(__file__).resolve().parents[2], timeout=120)
     assert proc.returncode == 2, proc.stderr
     assert proc.stdout.split() == ["False", "False"]
     assert proc.stderr.count("\n") == 1 and proc.stderr.startswith("error: --resolution = 100000000")

@@ -20,7 +20,7 @@ import pytest
 # a rod fine enough that the path takes several seconds (M = 400: ~11 s), so there is time to
 # stop it where the test wants
 RUN = [sys.executable, "-m", "ddg", "simulate", "--model", "rod", "--resolution", "400", "--quiet"]
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[3]
 
 
 def _start(out: Path, *extra: str) -> subprocess.Popen:

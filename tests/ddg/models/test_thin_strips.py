@@ -102,7 +102,7 @@ def test_the_shells_study_runs_pass_the_fold_too(run):
     import json
     from pathlib import Path
 
-    folder = Path(__file__).resolve().parents[1] / "data" / "fem_gold" / "dL0.5_W0.05_Lb4000" / run
+    folder = Path(__file__).resolve().parents[3] / "data" / "fem_gold" / "dL0.5_W0.05_Lb4000" / run
     summary = json.loads((folder / "summary.json").read_text())
     assert summary["status"] == "complete"
     fold = summary["fold_traces"][0]["from_dW_over_L"]
@@ -122,7 +122,7 @@ def test_the_plates_study_runs_pass_the_fold():
     import json
     from pathlib import Path
 
-    folder = Path(__file__).resolve().parents[1] / "data" / "plate_gold" / "dL0.5_W0.05_Lb4000"
+    folder = Path(__file__).resolve().parents[3] / "data" / "plate_gold" / "dL0.5_W0.05_Lb4000"
     for rows in ("R8", "R12"):
         s = json.loads((folder / rows / "summary.json").read_text())
         assert s["dW1_over_L"] < FOLD_OF_US < s["dW2_over_L"] and s["dW2_located_by"] == "fold"

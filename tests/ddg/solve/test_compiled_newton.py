@@ -67,8 +67,8 @@ def test_a_singular_band_is_reported_not_solved():
 def test_the_one_call_assembly_is_the_piecewise_one(cls):
     """Energy, gradient, Hessian and frames of rod_energy against the model's composition of the
     same pieces (evaluate_piecewise, the path checked against finite differences in
-    tests/test_wide_ribbons.py and tests/test_cross_section.py) at a random deformed state, frames
-    transported from another: equal to the summation's round-off (measured 4e-16 relative for the
+    tests/ddg/models/test_wide_ribbons.py and tests/ddg/energies/test_cross_section.py) at a random
+    deformed state, frames transported from another: equal to the summation's round-off (measured 4e-16 relative for the
     rod; the wide ribbons sum their terms in another order)."""
     rng = np.random.default_rng(2)
     model = cls(SCENE, 41)

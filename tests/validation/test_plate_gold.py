@@ -51,7 +51,7 @@ def test_stored_study_readme_lists_each_scenes_agreement_with_the_shell(folder):
 
     from validation.plate_gold import agreement_lines
 
-    root = Path(__file__).resolve().parents[1] / "data" / folder
+    root = Path(__file__).resolve().parents[2] / "data" / folder
     index = json.loads((root / "index.json").read_text())
     text = (root / "README.md").read_text()
     lines = agreement_lines(root, "plate" if folder == "plate_gold" else "plate-midedge")

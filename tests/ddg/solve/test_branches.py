@@ -96,7 +96,7 @@ def test_US_plus_and_US_minus_are_mirror_images(rod):
     junctions where H_mid(dW) has square-root ends. The two branches are sampled at different
     arclength points, so this is interpolation-limited (measured up to 1.5e-5 L where the samples
     are 0.02 apart); at equal dW the recorded paths of US+ and US- agree to 1e-7 L
-    (tests/test_thresholds.py)."""
+    (tests/ddg/solve/test_thresholds.py)."""
     s = rod.summary
     plus, minus = branch(rod, "US+", "dW_over_L"), branch(rod, "US-", "dW_over_L")
     inner = minus[(minus > s["dW1_over_L"] + 0.01) & (minus < s["dW2_S_stable_over_L"] - 0.01)]

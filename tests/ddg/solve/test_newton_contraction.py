@@ -79,7 +79,7 @@ def test_the_rods_path_with_the_test_has_the_same_thresholds_for_fewer_iteration
     assert on["newton_iterations"] < off["newton_iterations"]
     # threshold location does not use the test; it took 110 iterations both ways until the corrector
     # was compiled (issue 31 item 1), whose sums round differently at the fold: 110 against 109 since
-    # (bound restated after that measurement: within 2 %, as tests/test_compiled_newton.py)
+    # (bound restated after that measurement: within 2 %, as tests/ddg/solve/test_compiled_newton.py)
     assert on["threshold_newton_iterations"] <= 1.02 * off["threshold_newton_iterations"]
 
 

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 
-GOLD = Path(__file__).resolve().parents[1] / "data" / "fem_gold" / "dL0.5_W0.1667"
-PLATE_GOLD = Path(__file__).resolve().parents[1] / "data" / "plate_gold"
+GOLD = Path(__file__).resolve().parents[2] / "data" / "fem_gold" / "dL0.5_W0.1667"
+PLATE_GOLD = Path(__file__).resolve().parents[2] / "data" / "plate_gold"
 
 
 def _study(model, c, w):

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 BENCHMARKS = sorted((ROOT / "benchmarks").glob("*.py"))
 
 #: text that only a patch or caller-name introspection needs
@@ -200,7 +200,7 @@ def test_the_plate_benchmark_states_issue_31s_targets_with_what_each_figure_is_m
 
     from benchmarks import plate_path
 
-    report = json.loads((Path(__file__).parent.parent / "benchmarks/results/plate_path.json").read_text())
+    report = json.loads((Path(__file__).parents[2] / "benchmarks/results/plate_path.json").read_text())
     targets = plate_path.issue31_targets(report["results"])
     walls = [t for t in targets if t["unit"] == "s"]
     assert sorted(t["bound"] for t in walls) == sorted(plate_path.ISSUE31_WALL_TARGET_S.values())

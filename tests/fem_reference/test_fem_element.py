@@ -1,6 +1,6 @@
 """The FEM shell's element option (fem_reference.elements, issue 28 item 2): "P3" (u in [P3]^3,
 theta in [P3]^2) beside the default "P2B3". Input checking is tested without the FEM packages
-(tests/test_fem_inputs.py's pattern); the P3 element's correctness on the compressed clamped
+(tests/fem_reference/test_fem_inputs.py's pattern); the P3 element's correctness on the compressed clamped
 elastica needs dolfinx (skipped without it; CI installs it)."""
 from __future__ import annotations
 

@@ -190,7 +190,7 @@ def test_the_readme_table_and_count_are_the_committed_benchmark():
     (issue 28: the README's table and sentences match the CSV)."""
     from pathlib import Path
 
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     bench = (root / "data" / "benchmark" / "benchmark.md").read_text().splitlines()
     readme = (root / "README.md").read_text()
     table = [line for line in bench if line.startswith("|")]

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-DDG = Path(__file__).resolve().parents[1] / "ddg"
+DDG = Path(__file__).resolve().parents[2] / "ddg"
 
 
 def test_no_kernel_asks_numba_to_inline_it():

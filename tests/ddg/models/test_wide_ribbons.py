@@ -2,7 +2,7 @@
 ribbon-wunderlich (ddg.models.wide_ribbons) against exact solutions, the rod and their own limits.
 
 Their assembled derivatives are checked with the other rod-family models in
-tests/test_model_derivatives.py; here the physics: each is the rod (and the exact elastica) under
+tests/ddg/models/test_model_derivatives.py; here the physics: each is the rod (and the exact elastica) under
 compression, where the twist vanishes; each tends to the rod as the strip narrows at fixed
 thickness; the trapeze term adds T W^2 / 12 to the twist stiffness under a tension T; the
 Wunderlich ruling factor and its pole; the Sano-Wada regularisation length.
@@ -239,7 +239,7 @@ def test_coupled_terms_alone_match_finite_differences(kind, seed):
     import sys
     from pathlib import Path
 
-    sys.path.insert(0, str(Path(__file__).parent))
+    sys.path.insert(0, str(Path(__file__).parents[2]))
     from rod_states import rod_dof_scale, twisted_rod_state
 
     from ddg.models.ribbon import RibbonModel
@@ -247,7 +247,7 @@ def test_coupled_terms_alone_match_finite_differences(kind, seed):
     strip = ddg.Strip(length=0.1, width=0.005 if kind == "ribbon-wunderlich" else 0.01, thickness=0.001,
                       young_modulus=1e9, poisson_ratio=0.3)
     # (the cross-section ribbon has DOFs the rod lacks: its terms are checked alone in
-    # tests/test_cross_section.py and with the whole model in tests/test_model_derivatives.py)
+    # tests/ddg/energies/test_cross_section.py and with the whole model in tests/ddg/models/test_model_derivatives.py)
     if kind == "ribbon-trapeze":
         model, base = TrapezeRibbon(strip, 14), RodModel(strip, 14)
     else:

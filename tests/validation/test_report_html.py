@@ -16,7 +16,7 @@ import pytest
 
 from validation.report import FOLD, inline_markdown
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SNAPSHOT = ROOT / "validation" / "results" / "quick"
 PNG = b"\x89PNG\r\n\x1a\n"
 

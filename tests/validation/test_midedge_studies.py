@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 MIDEDGE = ROOT / "data" / "midedge_gold"
 
 #: The ten benchmark scenes (dL/L, W/L): validation/benchmark.py.

@@ -2,8 +2,8 @@
 
 What a solver sees of a model is `model.evaluate(q)`: the total energy, its gradient over all
 DOFs and its Hessian in band storage. The element kernels are checked on their own elsewhere
-(tests/test_plate_energies.py, tests/test_rod_energies.py, tests/test_sadowsky_energy.py); here
-the *assembled* derivatives of the plate (PlateModel), the rod (RodModel) and the Sadowsky ribbon
+(tests/ddg/energies/test_plate_energies.py, tests/ddg/energies/test_rod_energies.py,
+tests/ddg/energies/test_sadowsky_energy.py); here the *assembled* derivatives of the plate (PlateModel), the rod (RodModel) and the Sadowsky ribbon
 (RibbonModel) are checked against finite differences of the assembled energy, at random deformed
 states where every term is active, through the public model API only.
 
@@ -370,7 +370,7 @@ def test_rod_family_states_are_generic(kind, nodes):
         # measured: each part holds at least 1.5e-4 of the energy (twisting, where the ribbon's
         # quartic term dominates at zeta = 10 L), stretching and bending at least 0.3 %; the
         # trapeze term at least 3.5e-5 and the Wunderlich pairs 2.5e-7 (M = 9, seed 1: nearly
-        # uniform eta; those terms are checked alone in tests/test_wide_ribbons.py)
+        # uniform eta; those terms are checked alone in tests/ddg/models/test_wide_ribbons.py)
         # (the cross-section's bending along the strip, a c'' term, holds 8.8e-6 of it at M = 9, seed 0)
         floors = {"trapeze": 1e-5, "cross_section": 1e-5, "cross_section_bending": 2e-6, "wunderlich": 1e-7}
         assert all(abs(value) > floors.get(name, 5e-5) * ev.energy for name, value in ev.parts.items()), \

@@ -2,7 +2,7 @@
 and Hessian at generic deformed, twisted states, and its reduction to the rod's bending energy
 where the twist vanishes.
 
-Conventions as in tests/test_rod_energies.py: q is committed first, so reference frames are
+Conventions as in tests/ddg/energies/test_rod_energies.py: q is committed first, so reference frames are
 transported from q; the Hessian matches the symmetrised FD Jacobian of the gradient. DOFs are
 scaled to natural units (h for positions, 1 rad for angles).
 """

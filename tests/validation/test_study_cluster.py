@@ -28,7 +28,7 @@ from ddg.sweep import cluster as C
 
 pytest.importorskip("distributed")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DASK_EXTRA = "error: install the 'dask' extra: pip install ddg-strips[dask]\n"
 #: The plate's scenes here: W/L = 1/2 at both compressions, 4 (then 6) rows of triangles (90 and 182).
 PLATE_SCENES = ["dL0.5_W0.5", "dL0.25_W0.5"]

@@ -4,8 +4,9 @@ What a solver sees of a model is `model.evaluate(q)`: the total energy, its grad
 DOFs and its Hessian in band storage. The element kernels are checked on their own elsewhere
 (tests/ddg/energies/test_plate_energies.py, tests/ddg/energies/test_rod_energies.py,
 tests/ddg/energies/test_sadowsky_energy.py); here the *assembled* derivatives of the plate
-(PlateModel), the rod (RodModel) and the Sadowsky ribbon (RibbonModel) are checked against finite differences of the assembled energy, at random deformed
-states where every term is active, through the public model API only.
+(PlateModel), the rod (RodModel) and the Sadowsky ribbon (RibbonModel) are checked against finite
+differences of the assembled energy, at random deformed states where every term is active, through
+the public model API only.
 
 Conventions:
 

@@ -48,7 +48,8 @@ import ast
 import re
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+# the repository root: the first folder above this file that holds the ddg package (wherever tests/ nests it)
+ROOT = next(p for p in Path(__file__).resolve().parents if (p / "ddg" / "__init__.py").is_file())
 PACKAGE = ROOT / "ddg"
 MAX_MENTIONS = 10
 MAX_MODULE_LINES = 40

@@ -32,10 +32,10 @@ is searched, and each match of a rule below is one mention, reported at its file
 
 Outside the result values, a number after ``=`` or ``default`` is a parameter, not a figure
 (``dt = 0.01 s``, ``default 0.01 s``), and so are numbers in exponents (``L^2 times``,
-``A^-1 x``). Equation,
-figure, section and year numbers (``Eq. (6b)``, ``Fig. 8``, ``Sano and Wada 2019``), fractions
-(``3/2 times``), limits (``b -> 0``, ``lambda_min = 0``), tolerances of the contract (``1e-4 L``),
-orders (``O(h^2)``) and the paper's constants match no rule.
+``A^-1 x``). Equation, figure, section and year numbers (``Eq. (6b)``, ``Fig. 8``, ``Sano and
+Wada 2019``), fractions (``3/2 times``), limits (``b -> 0``, ``lambda_min = 0``), counts of a
+formula (``6M - 3 against 4M - 1``), tolerances of the contract (``1e-4 L``), orders
+(``O(h^2)``) and the paper's constants match no rule.
 
 The rules err on the side of catching more: a false alarm is a sentence to rephrase, a missed
 figure is one that goes stale in a docstring. At most MAX_MENTIONS mentions are allowed in ddg

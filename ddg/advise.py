@@ -1,65 +1,40 @@
 """Which model is enough for a scene: the error map read back, a conservative prediction of each
 model's error on a scene, and the cheapest model and resolution predicted within a tolerance
-(issue 17 item 4, rule v3 of issue 32: `python -m ddg advise`, `ddg.simulate(..., model="auto",
-tolerance=...)`).
+(`python -m ddg advise`, `ddg.simulate(..., model="auto", tolerance=...)`; the rule is RULE, v3).
 
 The error map (data/error_map/error_map.csv, written by `python -m validation.error_map`) has one
 row per (model, resolution, scene): for each quantity q of dW1/L, dW2/L and H_mid/L its error
-against the converged FEM reference of that scene and the reference's own error bar, and their sum
-`q_bound` (for H_mid the largest pointwise sum over the shear path, 0.02 L away from the
-reference's and the run's own thresholds), with the run's wall time. A bound is the whole error of
-that run: the model's error and its mesh's, measured against the reference. Rows of held-out scenes
-(column role = "held-out") are never used to predict: they exist to check the prediction.
+against the scene's converged FEM reference, that reference's error bar and their sum `q_bound`
+(for H_mid the largest pointwise sum over the shear path, 0.02 L away from the reference's and the
+run's own thresholds), with the run's wall time. Rows of held-out scenes (role "held-out") never
+predict: they check the prediction. The FEM rows are information only: ddg does not run the shell.
 
-Prediction rule v3 (conservative, never an extrapolation; fixed and committed before the
-references of its held-out scenes, fem_reference.gold.HELD_OUT_SCENES, were computed).
-A scene is (dL/L, W/L, L/b), nu = 0 (the map's; another nu is refused, check_mapped_poisson_ratio).
-Its L/b is read relative to the paper's strip at the same dL/L (relative slenderness
-(L/b) / (L/b)_paper(dL/L): the thickness in units of the paper's, since the paper's L/b grows with
-dL/L: 787 at 1/4, 886 at 1/3, 1181 at 1/2). Its basis is the corners of the map's box about it:
-the map compressions bracketing dL/L (the one equal to it to 0.1 %, else the nearest below and above);
-at each, the map widths bracketing W/L; at each of those, the relative slendernesses bracketing the
-scene's. A scene for which one bracket fails is outside the map.
-Candidates, each predicted on each quantity on its own (a missing bound makes that quantity
-unknown for that candidate only):
-- the rod's family (rod, ribbons), keyed by node count M: at each basis scene the bound of that M;
-- the plates, keyed by element size h/L = (W/L) / rows: the sizes measured at the basis scenes,
-  each as the even number of rows across the scene's W nearest W/h; at each basis scene the larger
-  bound of the two measured meshes whose sizes bracket h (the one of that size where equal), and
-  none where h lies outside the sizes measured there (no extrapolation in h either).
-The predicted error on q is the largest of those basis bounds times the map's cross-validated
-margin (below); the predicted cost the largest wall time of the meshes used at the basis scenes.
-The choice is the cheapest candidate predicted within the tolerance on every quantity asked that
-the map knows at the scene; a quantity no candidate has a bound for there (e.g. H_mid where the
-reference's runs stopped short) is reported unknown, not counted against every model. When no
-candidate is within, the choice is the most accurate candidate (least largest predicted error on
-the quantities asked), labelled as not within the tolerance with its predicted error. Outside the
-map nothing is predicted: the choice is the candidate most accurate at the nearest map scene
-(distance in log dL/L, log W/L, log relative L/b), at its node count or element size, labelled
-with an unknown error.
+Rule v3, conservative and never an extrapolation. A scene is (dL/L, W/L, L/b) at the map's nu = 0
+(another nu is refused: check_mapped_poisson_ratio), its L/b read relative to the paper's strip at
+the same dL/L (paper_slenderness). Its basis is the corners of the map's box about it: the map
+compressions bracketing dL/L (the one equal to it within SAME, else the nearest below and above), at
+each the map widths bracketing W/L, at each of those the relative slendernesses bracketing the
+scene's; if one bracket fails, the scene is outside the map. Each candidate is predicted on each
+quantity on its own (a missing bound makes that quantity unknown for that candidate only):
+- the rod's family, keyed by node count M: at each basis scene the bound of that M;
+- the plates, keyed by element size h/L = (W/L) / rows (the sizes measured at the basis scenes, as
+  even rows across the scene's W): at each basis scene the larger bound of the two measured meshes
+  whose sizes bracket h (the one of that size where equal), none outside the sizes measured there.
+The predicted error is the largest basis bound times the cross-validated margin; the predicted cost
+the largest wall time of the meshes used. The choice is the cheapest candidate predicted within the
+tolerance on every quantity asked that the map knows at the scene (a quantity no candidate has a
+bound for there is reported unknown); if none is, the most accurate candidate, labelled as not
+within the tolerance with its predicted error; outside the map, the candidate most accurate at the
+nearest map scene (distance in log dL/L, log W/L, log relative L/b), labelled with an unknown error.
 
-What a prediction is checked against (measured_error): at a scene with a reference, the candidate's
-error |q - reference| (the q_error column; for H_mid the largest pointwise difference), where its
-row has a bound. The prediction is built from bounds (error + the basis references' error bars), so
-it claims the error against a converged reference; the checking scene's own reference error bar is
-reported beside it, not added to the measured error (which would count that bar twice, once in the
-basis bounds and once in the measurement: rule v2 compared bound with bound). Fixed with rule v3,
-before its held-out references existed.
-
-Cross-validated margin (rule v2, kept). Errors are not monotone in the scene: the plate on 8 rows
-is worse at W/L = 1/8 than at 1/12 and at 1/6, so the largest bound of the bracketing scenes can
-understate an interior scene's error. The margin is measured on the fitting scenes alone,
-leave-one-out: each fitting scene bracketed by the others is predicted from them (margin 1, the
-plates at the rows measured there), and the margin is the largest ratio measured error / predicted
-error over every (candidate, quantity) there, and at least 1 (cross_validated_margin). It is
-recomputed from whatever map is read, never from the held-out scenes. On a scene of the map itself
-(one basis scene: nothing interpolated) the bound measured there is the prediction, margin 1.
-
-History: rule v1 (the largest bound of the bracketing scenes, one dL/L at a time) failed on its
-first held-out set; rule v2 added the margin and was checked on a second set; both fell back to a
-plate convergence pair whose mesh difference was reported as the error (issue 32: it understated the
-real error 8-18x on narrow strips). data/error_map/README.md gives every rule's held-out figures.
-The FEM rows of the map are information only: the shell is not run by ddg.
+The cross-validated margin: errors are not monotone in the scene, so the largest bound of the
+bracketing scenes can understate an interior scene's error. Leave-one-out on the fitting scenes:
+each scene bracketed by the others is predicted from them with margin = 1, and the margin is the
+largest ratio of a candidate's error there (`measured_error`: |q - reference|, the q_error column,
+where the row has a bound) to its prediction, over every (candidate, quantity); never below 1
+(cross_validated_margin), recomputed from whatever map is read. On a scene of the map itself its own
+bound is the prediction. How the rule came to be and how it held on held-out scenes:
+docs/findings/model_choice.md.
 """
 from __future__ import annotations
 
@@ -131,7 +106,7 @@ def check_quantities(value) -> tuple[str, ...]:
 def check_mapped_poisson_ratio(value) -> float:
     """nu as a float if the map has it (MAP_POISSON_RATIO); InputError naming it otherwise: the
     map's errors are measured at nu = 0, and nu moves the thresholds by as much as the tolerances
-    asked (issue 32: the rod's dW1/L by 0.0078 at nu = 0.25), so no error can be predicted."""
+    asked (docs/findings/model_choice.md), so no error can be predicted."""
     nu = float(value)
     if abs(nu - MAP_POISSON_RATIO) > 1e-12:
         raise InputError(f"poisson_ratio = {value!r}: the error map is measured at nu = {MAP_POISSON_RATIO:g} only "
@@ -455,8 +430,8 @@ def measured_error(row, q: str) -> float | None:
 
 def cross_validated_margin(rows, runnable=None) -> Margin:
     """Leave-one-out on the fitting rows (held-out rows are dropped first): each scene bracketed
-    by the others is predicted from them with margin 1; the margin is the largest ratio measured
-    error / predicted error over every (candidate, quantity) compared, and at least 1."""
+    by the others is predicted from them with margin = 1; the margin is the largest ratio of the
+    measured to the predicted error over every (candidate, quantity) compared, and never below 1."""
     rows = fitting(rows)
     worst, where, compared, scenes = 1.0, "none above 1", 0, 0
     for scene in map_scenes(rows):

@@ -248,7 +248,7 @@ def simulate(
     threshold whose states the discretisation does not resolve is reported null, with its
     value and the reason under `unresolved_thresholds` and in `warnings`.
     branches=True (with thresholds; default None: True for the rod, False for the plate, whose
-    diagram costs more than its path, 440 s against 265 s at 2000 triangles) then traces every
+    diagram costs more than its path: docs/findings/measured.md) then traces every
     branch of the shear stage by pseudo-arclength continuation, stable and unstable parts,
     through folds (U, US+, US-, and S from the first S state of the path; ddg.solve.branches):
     rows in result.branch_rows and out/branches.csv (path.csv's columns after a `branch`

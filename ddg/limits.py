@@ -107,8 +107,8 @@ GIB = 2.0**30
 
 
 def available_memory_bytes() -> float:
-    """The memory a run may count on: the machine's physical memory in bytes (8 GiB if it cannot
-    be read); tests replace it to make the checks independent of the machine."""
+    """The memory a run may count on: the machine's physical memory in bytes (default 8 GiB where
+    it cannot be read); tests replace it to make the checks independent of the machine."""
     try:
         return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     except (ValueError, OSError, AttributeError):

@@ -74,7 +74,7 @@ def plate_points(model, q, s, y):
 def default_plate_stations(model) -> int:
     """About one station per two columns of triangles: the line w = 0 interpolated through a
     structured mesh kinks where it crosses alternate columns, which a station per column turns
-    into a zigzag of kappa^(2) (+-6 % at 846 triangles, measured); two columns smooth it."""
+    into a zigzag of kappa^(2) (docs/findings/measured.md); two columns smooth it."""
     side = np.sqrt(4.0 * np.mean(model.mesh.triangle_areas) / np.sqrt(3.0))
     return max(11, int(round(0.5 * model.strip.length / (0.5 * np.sqrt(3.0) * side))) + 1)
 

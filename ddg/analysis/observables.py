@@ -5,7 +5,7 @@ with F the force the moving clamp applies to the strip (App. E: from the force b
 the constrained DOFs); F_axial_norm = P L / (E b^3) with P the compressive clamp force;
 lambda_min: lowest normalised eigenvalue of the free-DOF Hessian (see the model);
 stretching_share: the stretching (membrane) part of the elastic energy over the whole, the
-measure of membrane locking (issue 29: a thin strip stores almost all its energy in bending).
+measure of membrane locking (a thin strip stores almost all its energy in bending).
 """
 from __future__ import annotations
 
@@ -77,9 +77,8 @@ def unresolved_reason(rows: list[dict], shear_ratio: float) -> str | None:
     """Why the recorded states up to |dW/L| = shear_ratio (the compression and the first shear
     state past it included) are not resolved by the discretisation, or None if they are: the
     largest turn between neighbouring elements above RESOLVED_TURN_ANGLE_DEG, or the largest
-    strain above RESOLVED_STRAIN. Measured on the rod (dL/L = 1/2): turns up to dW1 of 96, 60,
-    43, 30 and 20 degrees at M = 7, 10, 14, 20 and 30, with dW1/L errors 0.055, 0.003, 0.007,
-    0.004, 0.002 against M = 100."""
+    strain above RESOLVED_STRAIN (how the turn relates to the thresholds' error on coarse rods:
+    docs/findings/measured.md)."""
     past = False
     worst_turn = worst_strain = None
     for row in rows:

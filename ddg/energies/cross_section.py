@@ -1,115 +1,40 @@
-"""The cross-section as a field: a strip's energy per unit length when its cross-section bends
-(issue 30; the long-wavelength reduction of Audoly and Neukirch 2021, "A one-dimensional model for
-elastic ribbons: a little stretching makes a big difference", JMPS, with the cross-section kept as
-an unknown field along the strip instead of eliminated point by point).
+"""The cross-section as a field: a strip's energy per unit length when its cross-section bends (the
+long-wavelength reduction of Audoly and Neukirch 2021, JMPS, with the cross-section kept as an
+unknown field along the strip instead of eliminated point by point). Every term derived, its limits
+and why a field: docs/physics/cross_section.rst; the labels F, X, X' and V are this module's.
 
-Derivation. A strip of width W, thickness b, Young's modulus E, Poisson ratio nu, plate stiffness
-D = E b^3 / (12 (1 - nu^2)), has centreline strains that vary slowly along it (arclength x): the
-stretch eps, the normal curvature kappa (the rod's kappa_n), the twist tau and the in-plane
-curvature kappa_g. Across the width, y in [-W/2, W/2], the cross-section deflects by w(x, y) normal
-to the strip; the centreline is the line of the cross-sections' centroids, int w dy = 0 (the
-rod's, and Audoly and Neukirch's, convention: eps is then the mean strain of the fibres).
-In the long-wavelength limit the
-transverse membrane stress vanishes (the long edges are free), and the Foppl-von Karman strip
-stores, per unit length,
+A strip of width W, thickness b, Young's modulus E, Poisson ratio nu, plate stiffness
+D = E b^3 / (12 (1 - nu^2)), has centreline strains per unit length eps (stretch), kappa (normal
+curvature, the rod's kappa_n), tau (twist) and kappa_g (in-plane curvature). Across the width,
+y in [-W/2, W/2], the even part of its deflection w(x, y) is written in n modes,
 
-    U = int { (E b / 2) e^2 + (D / 2) [kappa^2 + w_yy^2 + 2 nu kappa w_yy + 2 (1 - nu) (w_xy - tau)^2] } dy,
-    e_yy = -K = (w_xy - tau)^2 - (kappa + w_xx) w_yy,                                          (F)
+    w_yy = sum_j c_j y^(2j - 2),  w = sum_j c_j (B_j(y) - <B_j>),  B_j = y^(2j) / ((2j - 1) 2j),
 
-e being the axial strain of the fibre at y, whose second derivative across the width is minus the
-Gaussian curvature K of the deformed surface (compatibility with e_yy = e_xy = 0), e = eps -
-kappa_g y at y = 0 (the centreline's stretch and in-plane curvature). To first order in the
-derivatives along x, e(y) = eps - kappa_g y + tau^2 y^2 / 2 - kappa w(y) - 2 tau int int w_xy:
-the helix of a twisted strip lengthens its fibres by tau^2 y^2 / 2 (the trapeze effect,
-ddg.energies.trapeze), a fibre lifted by w on a centreline of curvature kappa shortens by kappa w,
-and a cross-section that changes along the strip shears the twist into an odd strain (below). The
-signs are those of the rod's frame (m1 the normal, y along m2, tau = m1' . m2), checked on a
-surface built from the rod's frames (tests/test_cross_section.py). The odd part of w relieves
-nothing (kappa_g keeps the rod's E b W^3 / 12). The even part is written in n modes,
-
-    w_yy = sum_j c_j y^(2j - 2),  w = sum_j c_j (B_j(y) - <B_j>),  B_j = y^(2j) / ((2j - 1) 2j),  j = 1 .. n,
-
-c_1 the transverse curvature at mid-width, <.> the mean over the width. With
-phi = (B_1, B_1 - <B_1>, ..., B_n - <B_n>), v = (tau^2, -kappa c_1, ..., -kappa c_n) and
-psi_j = 2 y^(2j + 1) / ((2j - 1) 2j (2j + 1)), e = eps - kappa_g y + phi . v - tau c' . psi, and (F)
-integrates to the
-rod's energy (E b W eps^2 / 2, EI kappa^2 / 2 with EI = E W b^3 / 12, GJ tau^2 / 2 with
-GJ = 2 D (1 - nu) W, E b W^3 kappa_g^2 / 24) plus this module's density
+c_1 the transverse curvature at mid-width (1/m), <.> the mean over the width (the centroid
+convention, int w dy = 0). The free-edged Foppl-von Karman strip (F) integrates over the width to
+the rod's energy plus this module's density (J/m)
 
     f = E b [eps m . v + v . S v / 2] + (D / 2) [c . P c + 2 nu kappa p . c + nu^2 W kappa^2]
         + D (1 - nu) c' . Q c' + E b [kappa_g tau c' . a + tau^2 c' . Psi c' / 2],              (X)
 
-    m_a = int phi_a (= 0 but for m_1 = W^3 / 24),  S_ab = int phi_a phi_b,  P_ij = int y^(2i + 2j - 4),
-    p_j = int y^(2j - 2),  a_j = int y psi_j,  Psi_ij = int psi_i psi_j,
-    Q_ij = int y^(2i + 2j - 2) / ((2i - 1)(2j - 1))   (integrals over the width),
+with v = (tau^2, -kappa c_1, ..., -kappa c_n), c' = dc/dx and m, S, P, p, a, Psi, Q integrals over
+the width (CrossSectionModes); plus the modes' bending along the strip,
+(D / 2) [c'' . R c'' + 2 nu c'' . N c] with c' = 0 at a clamp (X'), and the torsion-warping of the
+cross-section's rotation, E Gamma tau'^2 / 2 with E Gamma = D W^3 / 12 and tau = 0 at a clamp (V).
+Its limits are exact: c = 0 is the trapeze ribbon (ddg.energies.trapeze); tau = 0, nu = 0 the rod
+and the elastica; uniform strains with c eliminated the Audoly-Neukirch density
+E b W^5 Psi(k^4) (nu kappa^2 + tau^2)^2 / 8, k^4 = 3 (1 - nu^2) kappa^2 W^4 / b^2 (`psi`,
+`foundation_share`; `local_optimum` gives the modes' approximation of it).
 
-c' = dc/dx. The last two terms are the energy of a cross-section whose shape changes along the
-strip (w_xy = sum_j c_j' y^(2j - 1) / (2j - 1)): its twisting, and the odd membrane strain that
-Gauss's -2 tau w_xy makes of it, about (W^2 tau / b)^2 / 56 times the twisting for one mode. They
-make c a field with an adaptation length, 0.41 W (1 - nu)^(1/2) where kappa = tau = 0, shorter
-under twist. The modes' own bending along the strip, w_xx = sum_j c_j'' (B_j - <B_j>), adds
+Discretely c^e lives on the edges (after each twist angle, ddg.models.wide_ribbons), zero on the two
+clamped edges. Per interior node i with Voronoi length l, from the rod's integrated strains and the
+Voronoi mean stretch (ddg.energies.stencil_coupling):
 
-    (D / 2) [c'' . R c'' + 2 nu c'' . N c],  R_ij = int (B_i - <B_i>)(B_j - <B_j>) dy,
-    N_ij = int (B_i - <B_i>) y^(2j - 2) dy,                                                    (X')
+    E_i = l f(eps_i, kappa_i / l, tau_i / l, (c^{i-1} + c^i) / 2),  c' = (c^i - c^{i-1}) / l,  kappa_g -> kappa_g_i / l.
 
-with c' = 0 at a clamp (it holds w_x = 0 across its width): where the modes change over less than
-W (their layer at a clamp, about W / sqrt(kappa W^2 / b) long) it outweighs the c'^2 term, and
-without it the pitchfork moved with M (W/L = 1/12, dL/L = 1/2: dW1/L 0.3088, 0.3345, 0.3396 at
-M = 101, 201, 401). Not kept: the terms quadratic in the x-derivatives of c in the membrane strain
-(w_xy^2 - w_xx w_yy of Eq. F); the first-order term of w_xx in the bending, D kappa int w_xx,
-vanishes by the centroid convention.
-
-Its limits, all exact:
-- c = 0 (the cross-section kept straight): f = E b W^3 eps tau^2 / 24 + E b W^5 tau^4 / 640, the
-  trapeze ribbon (m_1 = W^3 / 24, S_11 = W^5 / 320);
-- tau = 0, nu = 0: f is a positive quadratic in c with its minimum c = 0 (the centroid convention
-  removes any eps kappa c coupling), the rod and the exact elastica (for nu > 0 an
-  untwisted strip bends anticlastically, c_1 = -nu kappa while
-  kappa W^2 / b is small: the rod's EI; the stretching stiffens it to D W for kappa W^2 / b
-  large, Ashwell's transition);
-- W^2 kappa / b -> 0 or W^2 tau / b -> 0: the stretching terms vanish as W^5, c_1 -> -nu kappa,
-  and (X) with the rod's terms is the rod;
-- uniform strains, c eliminated point by point: the Audoly-Neukirch density
-  E b W^5 Psi(k^4) (nu kappa^2 + tau^2)^2 / 8, k^4 = 3 (1 - nu^2) kappa^2 W^4 / b^2, whose exact
-  cross-section (`foundation_share`, `psi`: a beam on an elastic foundation, solved in closed
-  form) the n modes approximate: the relieved energy is within 0.8 % of it for k <= 8 with two
-  modes and overestimates it by up to 31 % (k = 6) with one (tests/test_cross_section.py). As
-  k -> infinity both give Sadowsky's ribbon, (D W / 2)(kappa^2 + tau^2)^2 / kappa^2.
-
-The rotation of the cross-section, w = theta y (its rigid part, the rod's twist angle), bends
-the fibres when the twist rate changes: w_xx = tau' y adds (D / 2) int tau'^2 y^2 dy, so per unit
-length
-
-    E Gamma tau'^2 / 2,  E Gamma = D W^3 / 12,                                                   (V)
-
-the torsion-warping (Vlasov) stiffness of a thin strip, with tau = 0 at a clamp: a clamp holds
-w_x = 0 along its whole width, so theta' = 0 there, which the rod's clamp (theta alone) does not.
-Twist rises from the clamp over the boundary layer sqrt(E Gamma / G J) = W / sqrt(24 (1 - nu)),
-0.20 W for nu = 0, where the U's twist is largest under shear; dropping it put the pitchfork dW1/L
-0.02 above the shell's at W/L = 1/20 (L/b = 100, 300). The modes' part of w_xx is Eq. X'.
-
-Why a field and not the point-wise elimination: eliminating c point by point gives a density that
-is not convex in kappa where the twist is strong and the curvature small (W^2 tau / b above
-22680^(1/4) / sqrt(3) = 7.1 for nu = 0: an inflection point of a twisted strip), and the discrete
-paths then depend on the mesh (measured on W/L = 1/20, dL/L = 1/2, L/b = 1181: the U's pitchfork at
-dW/L = 0.408 on 51 nodes, none on 101; the shell's is 0.351). With c a field, f is a convex
-quadratic in kappa at fixed c, and the c'^2 term lets the cross-section change only over its
-adaptation length, as it does in the plate.
-
-Discretely: c^e lives on the edges (after each twist angle, ddg.models.wide_ribbons), c = 0 on the
-two clamped edges, whose midpoints are the clamp points (the clamp holds the cross-section
-straight). Per interior node i, with l = dl_i (its Voronoi length, the distance between the
-midpoints of its edges), kappa -> kappa_i / l, tau -> tau_i / l (the rod's integrated strains),
-eps -> the Voronoi mean stretch (ddg.energies.stencil_coupling), c -> (c^{i-1} + c^i) / 2 and
-c' -> (c^i - c^{i-1}) / l:
-
-    E_i = l f(eps_i, kappa_i / l, tau_i / l, (c^{i-1} + c^i) / 2) with c' = dc / l, dc = c^i - c^{i-1}
-    (the c' terms of Eq. X, kappa_g -> kappa_g_i / l).
-
-`field_density` returns E_i and its exact first and second partials in the stencil's strains
-(eps, kappa_i, kappa_g_i, tau_i, c^{i-1}, c^i): f is a polynomial. Eq. X' is a constant quadratic
-form in the modes (`modes_curvature_form`, second differences over three edges); Eq. V couples
-neighbouring stencils' twists (`torsion_warping`).
+`field_density` returns E_i and its exact first and second partials (f is a polynomial); Eq. X' is a
+constant quadratic form in the modes (`modes_curvature_form`); Eq. V couples neighbouring stencils'
+twists (`torsion_warping`).
 """
 from __future__ import annotations
 

@@ -1,12 +1,11 @@
 """Mid-edge bending of a triangle mesh: a discrete Kirchhoff plate with the material's Poisson ratio.
 
-The second plate model (`plate-midedge`, ddg.models.midedge_plate). Where the paper's hinge
+The energy of the second plate model (`plate-midedge`, ddg.models.midedge_plate). The paper's hinge
 energy (Eq. 11b, ddg.energies.hinge_bending) weighs each edge's bending angle with a fixed
-coefficient, and so fixes the bending Poisson ratio at -1/3 and misweighs the edge rows of a
-free boundary, this energy builds each triangle's second fundamental form from the normals at
-its three edge midpoints and integrates the plate's bending energy density with the material's
-Poisson ratio nu (the mid-edge shells of Chen, Weischedel et al. 2018 and of libshell;
-linearised, the nonconforming Morley plate element, whose eigenvalues converge at second order).
+coefficient, which fixes the bending Poisson ratio at -1/3 and misweighs the edge rows of a free
+boundary; this one builds each triangle's second fundamental form from the normals at its three
+edge midpoints and integrates the plate's density with the material's Poisson ratio nu (the mid-edge
+shells of Chen, Weischedel et al. 2018 and libshell; linearised, Morley's nonconforming element).
 
 Mid-edge normals. Each edge e carries one angle DOF theta_e, the tilt of its mid-edge normal
 (the "director", perpendicular to the edge) from the normal of its first triangle a toward a's

@@ -31,9 +31,9 @@ module gives the partial derivatives of e, and `add_stencil_terms` applies the c
 
 in one compiled pass that writes straight into the assembled gradient and band. The first term,
 sum_c e_c hess s_c, is formed directly (`_stencil` with weights e_c): the two curvatures' second
-derivatives are sums of the same dyads, so their weighted sum costs one of them (the rod's
-evaluation at M = 100: 110 -> 95 microseconds). This module is the only implementation of the
-strains and their derivatives.
+derivatives are sums of the same dyads, so their weighted sum costs one of them (what that saves:
+docs/findings/measured.md). This module is the only implementation of the strains and their
+derivatives.
 """
 from __future__ import annotations
 
@@ -208,8 +208,8 @@ def _edge_form_to_stencil(ee, ef, ff, eth, fth, thth, out):
 
 @njit(cache=True)
 def _scratch():
-    """Work arrays of one stencil (allocated inside the compiled loops: a tuple of arrays passed
-    in from Python costs ~90 microseconds of dispatch per call): strains, ge, gf, gth."""
+    """Work arrays of one stencil: strains, ge, gf, gth. Allocated inside the compiled loops, because
+    a tuple of arrays passed in from Python costs a dispatch per call (docs/findings/measured.md)."""
     return np.empty(3), np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 2))
 
 

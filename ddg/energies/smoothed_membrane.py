@@ -1,6 +1,6 @@
 """Smoothed membrane of a triangle mesh: constant-strain triangles averaged over patches.
 
-The membrane-locking treatment of the mid-edge plate (ddg.models.midedge_plate, issue 29). A
+The membrane-locking treatment of the mid-edge plate (ddg.models.midedge_plate). A
 flat constant-strain triangle (ddg.energies.membrane) cannot follow a curved, twisted
 inextensible deformation whose rulings do not lie along mesh edges without changing its edge
 lengths; the spurious membrane energy, of order E b (h^2 kappa^2)^2 per area against the bending

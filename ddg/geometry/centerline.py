@@ -6,7 +6,7 @@ midpoint of edge 0 and the clamp at s = L the midpoint of edge M-2. Edge tangent
 sample the centerline at s = 0, h, ..., L exactly (edge e at s = e h), the curvature at node
 i sits at s = (i - 1/2) h between them, and the free length between the clamp points is
 exactly L. (Counting the rigid edges inside L instead shortens the free rod by 2h and
-biases H_mid by O(h), about 1.5 % at M = 100; with the straddling convention the error of
+biases H_mid by O(h), docs/physics/conventions.md; with the straddling convention the error of
 the clamped elastica falls as O(h^2).) The rest configuration lies along +x with the clamp
 at s = 0 at the origin; nodes sit at x = (i - 1/2) h.
 """

@@ -9,7 +9,7 @@ edges straddle its clamp points): the rigid triangles between them carry the cla
 slope, and a triangle's normal is the slope at the middle of its chord, x = 0. The free plate
 between the clamp lines is then exactly L, and the clamped elastica converges as O(h^2).
 (Clamping the columns at x = -h and 0 instead puts the clamped slope at x = -h/2, lengthens
-the plate by one spacing and biases H_mid by O(h): +0.84 % at the default mesh, measured.)
+the plate by one spacing and biases H_mid by O(h): docs/physics/conventions.md.)
 A mesh given without c (a file) is held to the same convention: its clamp zone at each end is
 its first layer of triangles, 2c deep, and it must be L + 2c long to round-off.
 
@@ -236,10 +236,10 @@ def plate_memory_estimate_bytes(length: float, width: float, triangles: int, *, 
     UNSTRUCTURED_BAND_FACTOR for an unstructured (gmsh) mesh; give them for an actual mesh
     (a file: its node count and PlateMesh.bandwidth_nodes()). The run holds RUN_BAND_COPIES
     banded matrices of 3N columns and 3 b + 3 rows (ddg.solve.banded; the plate's bandwidth
-    is 3 b + 2) and RUN_BYTES_PER_TRIANGLE per triangle; a few MB of fixed overheads (recorded
-    rows, eigensolver work) are left out (a complete 504-triangle path: 13 MB estimated, 20 MB
-    peak traced), so it is meant for the large sizes the machine cannot run, where the bands
-    dominate (ddg.limits.check_memory refuses them).
+    is 3 b + 2) and RUN_BYTES_PER_TRIANGLE per triangle; fixed overheads (recorded rows,
+    eigensolver work) are left out, so it underestimates small runs (docs/findings/measured.md)
+    and is meant for the large sizes the machine cannot run, where the bands dominate
+    (ddg.limits.check_memory refuses them).
     """
     if nodes is None or bandwidth_nodes is None:
         n, n_y = structured_size(length, width, triangles)
@@ -546,8 +546,8 @@ def structured_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANG
 
     equilateral=True: the columns of equilateral_columns instead of equally spaced ones (every
     triangle equilateral except in the strip next to each clamp), so that the rounding of the
-    counts does not make the lattice anisotropic (up to 2 % in the column spacing otherwise,
-    data/plate_modes/modes.md); the rest as below.
+    counts does not make the lattice anisotropic (the column spacing otherwise differs from the
+    equilateral one: data/plate_modes/modes.md); the rest as below.
 
     Columns of nodes at x = (j - 1/2) h_x, j = 0..n + 1, with n = L / h_x odd: the two clamped
     columns at each end straddle the clamp lines (module docstring). Regular columns hold

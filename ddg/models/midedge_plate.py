@@ -8,8 +8,7 @@ material (Young's modulus E, Poisson ratio nu for both membrane and bending):
 - membrane: constant-strain triangles (ddg.energies.membrane), plane-stress St Venant-Kirchhoff,
   by default mixed as the shell's partial selective reduced integration: alpha = b^2 / h^2 of
   them and 1 - alpha of their node-smoothed strains (ddg.energies.smoothed_membrane), against
-  membrane locking: on 8 rows it removes the pitchfork's thickness dependence between L/b = 300
-  and 1181, not at 4000 (issue 29, data/midedge_locking; `membrane="full"`: all CST);
+  membrane locking (what it removes: docs/findings/benchmark.md; `membrane="full"`: all CST);
 - bending: mid-edge normals (ddg.energies.midedge_bending): one angle DOF per edge, the
   triangle's second fundamental form from its three mid-edge normals (Morley's element when
   linearised), density D/2 [nu tr(M)^2 + (1 - nu) tr(M^2)] with D = E b^3 / (12 (1 - nu^2)).
@@ -44,7 +43,7 @@ from .names import MIDEDGE_PLATE
 #: Membrane discretisations: "psri", alpha = min(1, b^2 / h^2) of the constant-strain triangles and
 #: the rest node-smoothed (ddg.energies.smoothed_membrane), the treatment of membrane locking as
 #: the shell reference's partial selective reduced integration; "full", the constant-strain
-#: triangles alone (locks on coarse thin plates: issue 29).
+#: triangles alone (locks on coarse thin plates: docs/findings/benchmark.md).
 MEMBRANES = ("psri", "full")
 
 

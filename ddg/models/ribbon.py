@@ -35,9 +35,9 @@ class RibbonModel(RodModel):
 
     Choose M not a multiple of 4: the clamped elastica's inflection points sit at s = L/4 and
     3L/4, on node (M - 2)/4 + 1/2 when M = 0 mod 4, where kappa^(2) = 0 makes the quartic term a
-    maximum in kappa^(2) (Q_kk = -2 tau^4 / r^4): at M = 100 the symmetric U is a saddle from the
-    first shear step (lambda_min ~ -3e11, measured) and the path leaves it for a slightly
-    asymmetric state (2e-4 L at dW/L = 0.02). The default resolution is 101.
+    maximum in kappa^(2) (Q_kk = -2 tau^4 / r^4), so that the symmetric U is a saddle from the
+    first shear step and the path leaves it for a slightly asymmetric state
+    (docs/findings/models.md). The default resolution is 101.
     """
 
     name = RIBBON

@@ -6,8 +6,8 @@ transported in time (ddg.geometry.frames.rod_frames), the material curvatures (E
 twist (Eq. 5), the densities of bending (Eq. 6b), twisting (Eq. 6c) and, where zeta > 0, the
 Sadowsky term (ddg.energies.sadowsky), the stretching of the edges (Eq. 6a) and the stencils'
 chain rule (ddg.energies.rod_curvature.add_stencil_terms); no physics is written here. One call
-instead of a dozen saves the interpreter's ~30 microseconds per evaluation, and it is what the
-compiled Newton loop (ddg.solve.compiled_newton) calls.
+instead of a dozen spares the interpreter's dispatches (docs/findings/measured.md), and it is what
+the compiled Newton loop (ddg.solve.compiled_newton) calls.
 
 The ribbons with width add their terms in the same call, chosen by the kind in `args`'s last entry
 (the width terms, `width_terms`; kind ROD adds nothing) and compiled apart per kind (ENERGIES, by

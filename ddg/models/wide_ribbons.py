@@ -166,8 +166,8 @@ class CrossSectionRibbon(RodModel):
     def residual_floor(self) -> float:
         """The rod's floor times (W / h)^2 / 25 where that is above 1: the modes' membrane terms
         cancel the centreline's stretching to about 1e-2 (eps = -W^2 tau^2 / 24), and their
-        stiffness grows as (W / h)^2; measured at W/L = 1/12, M = 201 (W / h = 17): residual noise
-        3-5e-5 against the rod's floor 9.3e-6, so Newton stalled before the pitchfork."""
+        stiffness grows as (W / h)^2: with the rod's floor Newton stalled in round-off before the
+        pitchfork (docs/findings/models.md)."""
         ratio = (self.strip.width / self.centerline.spacing) ** 2 / 25.0
         return super().residual_floor() * max(1.0, ratio)
 

@@ -1,5 +1,5 @@
 """What a ParaView frame shows of a model's state: the surface, its flat reference, and per-element
-fields (issue 18 item 7; written by ddg.output.frames.FrameWriter).
+fields (written by ddg.output.frames.FrameWriter).
 
 * Plate (any triangle mesh): the deformed triangles; per triangle `turn_angle_deg` (the largest
   angle between its normal and a neighbour's: where it exceeds 30 degrees the mesh stops

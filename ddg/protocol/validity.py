@@ -1,4 +1,4 @@
-"""Warnings for results that lie outside their model's or mesh's validity (issue 18 item 1).
+"""Warnings for results that lie outside their model's or mesh's validity.
 
 Three cases, each a line of summary.json's `warnings` (the CLI prints them, the API raises each as
 a ValidityWarning):
@@ -6,12 +6,11 @@ a ValidityWarning):
 * Width (1D models: the rod and the ribbons, which carry no width or only a width term). The
   error map (data/error_map/error_map.csv, ddg.advise) predicts each model's dW1/L error plus the
   reference's error bar on the scene; where even the model's best resolution there is predicted
-  above WIDTH_TOLERANCE (0.01 L, the tolerance of issue 17's "which model is enough"), or the map
-  has no dW1 of that model there, or the scene is wider than the map or at a dL/L or L/b it
-  does not cover, the warning says so with the figures and the basis. dW1 is the quantity: it is
-  the pitchfork whose width dependence is Fig. 8, and on the paper's narrow strip (W/L = 1/20,
-  L/b = 1181) the rod is within it (0.0055 L) while at W/L = 1/12 it is not (0.027 L). A scene
-  narrower than the map's narrowest strip is not flagged. Without a map file, no width check.
+  above WIDTH_TOLERANCE (0.01 L, the tolerance of "which model is enough"), or the map has no dW1
+  of that model there, or the scene is wider than the map or at a dL/L or L/b it does not cover,
+  the warning says so with the figures and the basis. dW1 is the quantity: it is the pitchfork
+  whose width dependence is Fig. 8 (where the rod meets the tolerance: docs/findings/model_choice.md).
+  A scene narrower than the map's narrowest strip is not flagged. Without a map file, no width check.
 * Mesh: the recorded path went past the last state the discretisation resolves (neighbouring
   elements turning by more than RESOLVED_TURN_ANGLE_DEG, or a strain above RESOLVED_STRAIN;
   ddg.analysis.observables), with the shear where it happened; for the 1D model with its

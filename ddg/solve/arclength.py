@@ -172,8 +172,8 @@ class ArclengthTracer:
         it ended.
 
         keep_hessians=False keeps the Hessian on the last state only (each is a band of the whole
-        model: on a 15000-triangle plate about 90 MB, so a 200-point trace held 17 GB); the
-        others keep q, energy, gradient and frames, all that interpolating between them needs."""
+        model, which on a fine plate makes a long trace run out of memory: docs/findings/measured.md);
+        the others keep q, energy, gradient and frames, all that interpolating between them needs."""
         model = self.model
         opts = self.options
         free = model.free

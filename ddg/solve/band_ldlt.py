@@ -34,9 +34,9 @@ Cost: about n b^2 flops for bandwidth b (as the banded Cholesky), 4 n b per solv
 works on the transposed band t (n, b + 1), t[j, r] = A[j + r, j], so that each column's rank-1
 update runs over contiguous memory; for b >= BLOCKED_FROM it eliminates PANEL columns at a time
 and applies their update to the band on their right as dense matrix products (np.dot, BLAS),
-gathered from and scattered back to t (the products also fill part of the upper triangle: about
-1.3 times the flops of the unblocked loop at bandwidth 240, most of them in BLAS). The compiled
-code is cached next to this module (__pycache__) by numba.
+gathered from and scattered back to t (the products also fill part of the upper triangle, so
+they do more flops than the unblocked loop, most of them in BLAS). The compiled code is cached
+next to this module (__pycache__) by numba.
 """
 from __future__ import annotations
 

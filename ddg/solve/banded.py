@@ -92,8 +92,8 @@ class SymmetricBanded:
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """A^-1 rhs: banded Cholesky where A is positive definite; otherwise LDL^T without pivoting
-        (about the Cholesky's cost; on the plate's indefinite Hessians 3-4 times cheaper than banded
-        LU), checked by its residual, and banded LU (partial pivoting) where that check fails."""
+        (about the Cholesky's cost, cheaper than banded LU: benchmarks/results/plate_linear_algebra.md),
+        checked by its residual, and banded LU (partial pivoting) where that check fails."""
         if self.cholesky():
             return sla.cho_solve_banded((self._cholesky, True), rhs, check_finite=False)
         ldlt = self.ldlt()
@@ -117,7 +117,7 @@ class SymmetricBanded:
 
         Positive definite (Cholesky succeeded): Lanczos on the inverse, O(n b^2) to factor and
         O(n b) per iteration, exact for the lowest eigenvalues because all are positive.
-        Otherwise the smallest shift sigma (growing by 4x from 1e-8 of the mean diagonal) that
+        Otherwise the smallest shift sigma in 1e-8, 4e-8, 16e-8, ... times the mean diagonal that
         makes A + sigma I positive definite brackets the lowest eigenvalue in (-sigma, -sigma/4],
         and Lanczos on (A + sigma I)^-1 finds it and its neighbours.
         """

@@ -1,11 +1,9 @@
-"""BLAS threads during a run (issue 31 item 3): the band factorisations single-threaded.
+"""BLAS threads during a run: the band factorisations single-threaded.
 
 The solvers' linear algebra is banded Cholesky, LDL^T and LU of bandwidth 10-200 (ddg.solve.banded)
 and shift-invert Lanczos on them: too small for a multi-threaded BLAS to gain, and a threaded BLAS
-whose other thread waits for a busy core spins. Measured on the paper's plate at 2100 triangles
-(../shared/PERFORMANCE-NOTES.md; benchmarks/results/plate_linear_algebra.md, one thread faster in
-7 of 7 cases): 20.8 s idle and 57.9 s beside one busy single-threaded process with OpenBLAS's
-default threads, 18.0 s both idle and beside it with one thread.
+whose other thread waits for a busy core spins (what that costs: docs/findings/measured.md, "BLAS
+threads"; benchmarks/plate_linear_algebra.py and benchmarks/plate_under_load.py measure it).
 
 `blas_threads()` is the context every run executes in (ddg.protocol.driver.execute, so the
 command line, the API, sweeps and the report alike): the BLAS libraries this process has loaded

@@ -9,8 +9,8 @@ residual and correction measures, the banded Cholesky where the free Hessian is 
 definite and otherwise LDL^T without pivoting checked by its residual, then LU (as
 SymmetricBanded.solve), the same energy or residual line search, the round-off stall, the give-up
 and contraction tests, the frames committed at each accepted iterate. Python is touched once per
-load step instead of about ten times per iteration (~30 us each on the rod's M = 100: the
-benchmark benchmarks/rod_path.py). ddg.solve.newton.newton calls it where the model offers a
+load step instead of about ten times per iteration (what each costs: docs/findings/measured.md;
+benchmarks/rod_path.py measures the path). ddg.solve.newton.newton calls it where the model offers a
 compiled energy (`assembly_args`) and falls back to its own loop otherwise; tests/
 test_compiled_newton.py checks that both take the same iterations to the same states.
 

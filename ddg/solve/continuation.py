@@ -508,8 +508,7 @@ class PathFollower:
         kick while the energy keeps falling with it (the multiplier mu has the sign of -dE/da),
         then the root of mu(a) is bracketed and found by the secant method; plain Newton from there
         lands on the equilibrium, accepted if stable. A fixed push followed by modified Newton
-        slides along the soft, curved valley instead: 225 iterations past the rod's pitchfork
-        (M = 100) against ~30 here."""
+        slides slowly along the soft, curved valley instead (docs/findings/measured.md)."""
         model = self.model
         L = self._length
         saved = model.save_frames()

@@ -37,33 +37,28 @@ from .newton import NewtonOptions, newton
 class DynamicOptions:
     """Settings of the implicit-Euler option.
 
-    clamp_speed (m/s): 1e-3, the paper's 1 mm/s in both stages (sections 4.1, 4.2).
+    clamp_speed (m/s): default 1e-3, the paper's 1 mm/s in both stages (sections 4.1, 4.2).
 
-    time_step (s): largest step, 0.01 s. At 1 mm/s the clamp moves 10 um per step, under 1 %
-    of the rod spacing h = L/(M-2) (1.5 mm for the paper's L = 0.15 m at M = 100). The step is
-    shortened so that every recorded load is reached exactly (an integer number of equal steps
-    per recorded interval). Implicit Euler is unconditionally stable; the buckled strip's lowest
-    frequencies are omega ~ 180-520 rad/s away from the thresholds (K v = omega^2 M v measured for
-    W/L = 1/20, dL/L = 1/2, M = 100, over the whole shear path), so omega dt > 1 and the scheme
-    dissipates elastic vibrations within a few steps: as in the paper it is a device for
-    following quasi-static equilibria, not for resolving vibrations (use dt << 1/omega for that).
+    time_step (s): the largest step, default 0.01 s, shortened so that every recorded load is
+    reached exactly (an integer number of equal steps per recorded interval). At 1 mm/s the clamp
+    moves 10 um per step, a small fraction of the rod spacing h = L/(M-2). Implicit Euler is
+    unconditionally stable; away from the thresholds the buckled strip's lowest frequencies
+    (K v = omega^2 M v) give omega dt > 1 (docs/findings/models.md), so the scheme dissipates
+    elastic vibrations within a few steps: as in the paper it is a device for following
+    quasi-static equilibria, not for resolving vibrations (use dt << 1/omega for that).
 
-    damping (1/s): rate c of the viscous force -c M v, 20 1/s. Two conditions make the response
-    quasi-static at 1 mm/s, and away from the thresholds this value meets both by orders of
-    magnitude: (i) disturbances (the start of each stage, a snap past a bifurcation) must die
-    out well before the next recorded load; the amplitude of a slow, lightly damped mode decays as exp(-c t / 2), a
-    time constant of 0.1 s = 0.1 mm of clamp travel, against ~1-2 mm between recorded loads;
-    (ii) on a load ramp a mode of frequency omega trails its equilibrium by c v / omega^2 (for
-    implicit Euler exactly as in the continuous equation, since inertia vanishes on a ramp):
-    with omega >= 180 rad/s this is <= 6e-7 m, ~4e-6 L, far below the spatial discretisation
-    error. Near a threshold omega -> 0 and the lag grows (critical slowing down); there the
-    dynamic and static paths differ by construction (measured: up to ~6e-4 L in H_mid/L at
-    the US -> S transition, M = 100, 1 mm/s). That lag is proportional to c (measured at M = 30,
-    3 mm/s: max |dH_mid|/L = 3.7e-6, 2.4e-5, 8.5e-5, 3.2e-4 for c = 0, 5, 20, 80 1/s). c = 0 also
-    works at dt = 0.01 s, because implicit Euler then dissipates through its own numerical
-    damping (rate ~ omega^2 dt / 2 for omega dt < 1), but that depends on dt; c = 20 1/s keeps
-    the decay of slow modes independent of dt, at a cost of ~1e-4 L at the thresholds (median
-    over the path 3e-8 L) in that measurement.
+    damping (1/s): rate c of the viscous force -c M v, default 20 1/s. Two conditions make the
+    response quasi-static, and away from the thresholds this value meets both with a wide margin:
+    (i) disturbances (the start of each stage, a snap past a bifurcation) die out well before the
+    next recorded load: a slow, lightly damped mode decays as exp(-c t / 2), with the time constant
+    2/c = 0.1 s, a tenth of a millimetre of clamp travel at 1 mm/s; (ii) on a load ramp a mode of
+    frequency omega trails its equilibrium by c v / omega^2 (for implicit Euler exactly as in the
+    continuous equation, since inertia vanishes on a ramp), far below the spatial discretisation
+    error. Near a threshold omega -> 0 and the lag grows (critical slowing down): there the dynamic
+    and static paths differ by construction, by a lag proportional to c. c = 0 also works, because
+    implicit Euler then dissipates through its own numerical damping (rate ~ omega^2 dt / 2 for
+    omega dt < 1), but that depends on dt; c > 0 keeps the decay of slow modes independent of dt.
+    What the lag and the frequencies measured: docs/findings/models.md.
 
     record_interval (s): None records at the static solver's loads (protocol.compression_steps
     and protocol.shear_steps equally spaced targets per stage); a number records every

@@ -4,15 +4,9 @@ continuation (ddg.solve.arclength, in arclength).
 
 Near a smooth branch the predictor's error falls as h^k for k points a step h apart, and Newton
 from it needs about log2(log(error / tolerance)) iterations, so a higher order pays while the
-polynomial stays well conditioned. Measured on the rod (M = 100, W/L = 1/20, dL/L = 1/2, full
-default path with thresholds and branches; Newton iterations):
-
-- branch tracing (pseudo-arclength, steps of up to 0.02 L): 3 points 1067, 4 points 792,
-  5 points 650, 6 points 639, 7 points 981 (the degree-6 polynomial overshoots);
-- the recorded path (load steps): 3 points 980, 4 points 779, 5 points 732, but threshold
-  location, which restarts from recorded states, 342 with 4 points and 407 with 5.
-
-Hence five points for arclength and four for the load path.
+polynomial stays well conditioned. Five points serve arclength (ARCLENGTH_PREDICTOR_POINTS) and
+four the load path (LOAD_PREDICTOR_POINTS), the counts that took the fewest Newton iterations on
+the rod's default path (docs/findings/measured.md).
 """
 from __future__ import annotations
 

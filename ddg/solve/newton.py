@@ -51,14 +51,12 @@ class NewtonOptions:
     # converges more slowly than the rate 1/2 of Newton at a singular point, and a shorter load step
     # is cheaper. Off near thresholds (the patient steps, where Newton converges linearly) and, for
     # the rest of a path, once the path would stop with it (PathFollower); None switches it off.
-    # Measured (benchmarks/results/newton_contraction.md, 11 models and scenes): 1-13 % fewer path
-    # iterations on the 8 paths that complete, thresholds unchanged to 1.2e-6 L, no status changed,
-    # the paper's plate at W/L = 1/6 17.9 -> 14.6 s; the 3 paths that stop anyway (Wunderlich,
-    # cross-section) spend 36-62 % more before they stop, retrying without the test.
+    # What it saves on the paths that complete and costs on those that stop anyway:
+    # benchmarks/results/newton_contraction.md (benchmarks/newton_contraction.py).
     contraction_limit: float | None = 0.5
     # Run a plain Newton step in one compiled call (ddg.solve.compiled_newton) where the model has a
-    # compiled energy (the rod and the Sadowsky ribbons): the same iterations, ~2x less time per step
-    # on the rod (benchmarks/results/rod_path.md). False runs the loop below for every model.
+    # compiled energy (the rod family): the same iterations in less time per step
+    # (benchmarks/results/rod_path.md). False runs the loop below for every model.
     compiled: bool = True
 
     def __post_init__(self) -> None:

@@ -21,7 +21,7 @@ def lowest_modes(model, hessian, count: int = 1, vectors: bool = False):
     converge, use ARPACK's shift-invert Lanczos on the scaled matrix, which gives the eigenvectors
     with the eigenvalues: both are kept on `hessian` (an evaluation's, which nothing changes), so
     that a later request for them on the same state (branch switching from an unstable state whose
-    lambda_min was recorded, issue 31 item 2) reuses them instead of solving again."""
+    lambda_min was recorded) reuses them instead of solving again."""
     kept = getattr(hessian, "_lowest_modes", None)
     if kept is not None and kept[0].shape[0] >= count:
         w, v = kept
@@ -30,8 +30,7 @@ def lowest_modes(model, hessian, count: int = 1, vectors: bool = False):
     if count == 1 and not vectors:
         K = model.free_matrix(hessian)
         # narrow bands only (the rod's is 10): on the plate's (83-131) the compiled triangular
-        # solves lose to ARPACK with LAPACK's (eigen time per iteration 3.1 -> 4.1 ms at 5740
-        # triangles, measured)
+        # solves lose to ARPACK with LAPACK's (docs/findings/measured.md)
         if K.band.shape[0] - 1 <= LANCZOS_MAX_BANDWIDTH and K.cholesky():
             lam = lowest_eigenvalue(K.cholesky_factor, metric)
             if lam is not None:

@@ -82,14 +82,13 @@ def half_turn_odd_part(model, q: np.ndarray, compression: float, shear: float) -
 
 
 class BranchOrientation:
-    """The + / - of US and S kept along a continuous path (issue 18: the sign of rise() alone turns
-    S+ into S- near dW_max, where the lobes of S flatten and the out-of-plane profile reverses
-    continuously; measured on the rod at W/L = 1/20, dL/L = 1/2: rise() changes sign at dW/L =
-    0.80 while the path is one smooth branch). The first asymmetric state after U (or after the
-    start) takes the sign of phase_label (rise()); every later one keeps its predecessor's sign if
-    their half-turn-odd parts (half_turn_odd_part) point the same way (positive inner product), else
-    the opposite one: a label changes only where the shape jumps to the mirror branch. Back on U
-    (or flat) the memory is cleared."""
+    """The + / - of US and S kept along a continuous path (the sign of rise() alone turns S+ into
+    S- near dW_max, where the lobes of S flatten and the out-of-plane profile reverses
+    continuously while the path is one smooth branch: docs/findings/measured.md). The first
+    asymmetric state after U (or after the start) takes the sign of phase_label (rise()); every
+    later one keeps its predecessor's sign if their half-turn-odd parts (half_turn_odd_part) point
+    the same way (positive inner product), else the opposite one: a label changes only where the
+    shape jumps to the mirror branch. Back on U (or flat) the memory is cleared."""
 
     def __init__(self):
         self._last: tuple[str, np.ndarray] | None = None

@@ -39,8 +39,8 @@ TRIAL_MIN_SUBSTEP = 1.0 / 64
 
 def _follower(model, options, switching: bool) -> PathFollower:
     """A path follower for the refinements: near the thresholds Newton converges only linearly, so
-    without the load steps' fail-fast on contraction (NewtonOptions.contraction_limit; with it the
-    rod's threshold location at M = 400 took 1556 Newton iterations against 968, measured)."""
+    without the load steps' fail-fast on contraction (NewtonOptions.contraction_limit), which there
+    costs more iterations than it saves (docs/findings/measured.md)."""
     newton_options = replace(options.newton, contraction_limit=None)
     return PathFollower(model, replace(options, newton=newton_options, branch_switching=switching,
                                        min_substep=max(options.min_substep, TRIAL_MIN_SUBSTEP)))
@@ -113,7 +113,7 @@ def _interpolated_root(samples: list, a: float, b: float, tolerance: float) -> f
     quadratic through the three samples nearest the bracket and the secant through the two nearest
     its root agree within tolerance / 2 (lambda_min is smooth in dW along the branch). Spares the
     solves at the critical point itself, where the Hessian is singular and Newton converges slowly
-    (the rod at M = 400 spent ~5000 iterations there)."""
+    (docs/findings/measured.md)."""
     if len(samples) < 3:
         return None
     low, high = min(a, b), max(a, b)

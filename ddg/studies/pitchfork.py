@@ -174,7 +174,8 @@ def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float
       models' U states there (the ribbon's U branch followed directly from the flat strip);
     - at dW = rod_dW1 + beyond: the ribbon's U state (direct) and its US state (relaxed from the
       rod's US+), their energies, H_mid, and the straight-line barrier between them (and, with
-      drag_samples > 0, the two-sided drag estimate of the barrier, ~20 s at 21 samples).
+      drag_samples > 0, the two-sided drag estimate of the barrier, a constrained minimisation
+      per sample).
     """
     options = options or ContinuationOptions()
     L = strip.length

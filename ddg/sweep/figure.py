@@ -192,7 +192,7 @@ def _caption(rows, usable, gold, panels) -> str:
 
 
 def _spread(values: list[float], lo: float, hi: float, logx: bool) -> list[float]:
-    """The values to label on the W/L axis, at least 8 % of the axis apart (the first kept)."""
+    """The values to label on the W/L axis, at least 0.08 of the axis length apart (the first kept)."""
     scale = (lambda v: math.log(v)) if logx else (lambda v: v)
     gap = 0.08 * (scale(hi) - scale(lo)) if hi > lo else 0.0
     kept: list[float] = []

@@ -88,7 +88,7 @@ class RunSpec:
 
 def code_version() -> str:
     """sha256 of the ddg package's sources (but ORCHESTRATION): a change of the solver
-    invalidates the cache. Read afresh at each call (5-10 ms): the files, not the modules loaded."""
+    invalidates the cache. Read afresh at each call: the files, not the modules loaded."""
     return _code_version(PACKAGE)
 
 

@@ -8,7 +8,7 @@ for each node count M: ddg.simulate(strip, LoadingProtocol(dL/L), model, resolut
 branches=False) for model = rod and ribbon-cross-section, alternately in this process, best of
 --repeat (after one warm-up call of each model, so compilation is not timed), with the CPU time,
 Newton iterations and status of the best run. Writes OUT/cross_section_path.json and .md
-atomically. Not part of the test run; tests/test_cross_section_targets.py reads the JSON.
+atomically. Not part of the test run; tests/validation/test_cross_section_targets.py reads the JSON.
 """
 from __future__ import annotations
 

@@ -405,7 +405,7 @@ the clamp force F_shear L/(E b^3) (`F_shear_curve`), from the meshes that reache
 curve ends where fewer than two go on). Until issue 28 (rule 1) a non-asymptotic sequence whose
 differences shrank got |d2| alone and every order 1.25; at W/L = 1/6, dL/L = 1/2 that bar (0.0010)
 was 3.5 times smaller than the distance to an independent isotropic mesh series' extrapolation.
-Tested on constructed sequences in tests/test_fem_gold_study.py.
+Tested on constructed sequences in tests/fem_reference/test_fem_gold_study.py.
 `--studies-only` rewrites the studies and this file from the stored runs without running any.
 
 ## What exists (written by the gold command)

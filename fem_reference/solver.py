@@ -4,7 +4,7 @@ Linear algebra: the tangent K (symmetric, indefinite past an instability) is fac
 MUMPS as L D L^T (PETSc PCCHOLESKY with MUMPS, sym = 2); with ICNTL(13) = 1 (no ScaLAPACK root
 node) and ICNTL(24) = 1 (null-pivot detection) PETSc's MatGetInertia returns the exact inertia
 of D, hence the number of negative eigenvalues of the constrained tangent (Sylvester). Measured
-on PETSc 3.18.5: the count agrees with SLEPc's eigenvalues (tests/test_fem_reference.py).
+on PETSc 3.18.5: the count agrees with SLEPc's eigenvalues (tests/fem_reference/test_fem_reference.py).
 Dirichlet rows and columns are replaced by the identity (diagonal 1), which adds only positive
 eigenvalues, and by 0 on the metric M, which sends them to infinity in K v = lambda M v.
 

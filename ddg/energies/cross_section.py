@@ -453,7 +453,7 @@ def local_optimum(kappa, tau, modes: CrossSectionModes):
 
 
 #: Taylor coefficients of Psi(s) = sum_n a_n s^n (exact rationals from the series of Phi(k) / k^4,
-#: tests/test_cross_section.py re-derives the first ones); the radius of convergence is about
+#: tests/ddg/energies/test_cross_section.py re-derives the first ones); the radius of convergence is about
 #: s = 125, so at s < SERIES_BELOW = 4 the 14 terms leave a relative error below 1e-20.
 _SERIES = np.array([
     1 / 180, -1 / 22680, 2879 / 8172964800, -3911 / 1389404016000,

@@ -5,7 +5,7 @@ its counter-clockwise vertices (p0, p1, p2) as n = u / |u|, u = (p1 - p0) x (p2 
 mesh has all normals +z and zero energy. |n_a - n_b|^2 = 2 (1 - n_a . n_b) = 4 sin^2(theta/2)
 with theta the dihedral (bending) angle.
 
-Continuum limit (Seung and Nelson 1988; measured in tests/test_plate_energies.py): on an
+Continuum limit (Seung and Nelson 1988; measured in tests/ddg/energies/test_plate_energies.py): on an
 equilateral mesh a constant c gives an isotropic bending energy density D_eff/2 (2H)^2 with
 D_eff = sqrt(3) c, for any bending direction. So the paper's c = E b^3 / (12 sqrt(3)) gives
 exactly D_eff = E b^3 / 12, the plate bending stiffness with Poisson ratio 0 (the rod's EI2 / W).

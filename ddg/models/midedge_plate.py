@@ -16,7 +16,7 @@ material (Young's modulus E, Poisson ratio nu for both membrane and bending):
 A narrow strip of this plate bends like the rod, EI2 = D (1 - nu^2) W = E W b^3 / 12, and twists
 with GJ = 2 D (1 - nu) W = E W b^3 / (6 (1 + nu)) (the paper's Eq. A.1), where the paper's
 plate, with its bending Poisson ratio -1/3, twists 4/3 stiffer (tested in
-tests/test_midedge_plate.py).
+tests/ddg/models/test_midedge_plate.py).
 
 DOFs: the nodes' positions (3 each) and the edges' angles (1 each), ordered together by x (of
 the node, of the edge's midpoint) so the Hessian is banded and the clamped DOFs come first and

@@ -12,7 +12,7 @@ Stiffnesses (derived in ddg.energies.hinge_bending and tested):
 - bending: c_h = D |e_bar|^2 / (2 (A_a + A_b)) per hinge with D = E b^3 / 12: on equilateral
   triangles exactly Eq. (11b)'s E b^3 / (12 sqrt(3)), whose continuum limit has the plate
   bending stiffness D (Seung and Nelson 1988) and a Gaussian modulus of -4/3 D, i.e. a
-  bending Poisson ratio nu_b = -1/3 (measured in tests/test_plate_energies.py). Consequences
+  bending Poisson ratio nu_b = -1/3 (measured in tests/ddg/energies/test_plate_energies.py). Consequences
   for a strip, compared with the rod at nu = 0: a narrow plate bends as a beam of stiffness
   D (1 - nu_b^2) W = 8/9 EI2 (its Euler loads, tested) and twists with GJ = 2 D (1 - nu_b) W,
   4/3 of the rod's E W b^3 / 6; the stiffness ratio that sets the thresholds differs by 3/2.

@@ -25,7 +25,7 @@ RIBBON_INITS = ("direct", ROD)
 
 #: Default regularisation length zeta / L of Eq. (A.5). At W/L = 1/20, dL/L = 1/2, M = 101 the
 #: shear path (H_mid up to dW/L = 0.5, direct and rod-initialised) differs from zeta / L = 1e8 by
-#: 1.7e-6 L at zeta / L = 10, 1.7e-8 L at 100 and less beyond (measured; tests/test_ribbon.py);
+#: 1.7e-6 L at zeta / L = 10, 1.7e-8 L at 100 and less beyond (measured; tests/ddg/models/test_ribbon.py);
 #: the Sano-Wada value W^2 / (b sqrt 60) = 0.38 L shifts it by ~1e-3 L. The paper sets zeta = 1e8.
 DEFAULT_ZETA_OVER_L = 1e4
 

@@ -159,7 +159,7 @@ class RodModel(BandedModel):
     def evaluate_piecewise(self, q: np.ndarray, gradient: bool = True, hessian: bool = True) -> Evaluation:
         """evaluate() composed in Python of the same compiled pieces, one call per piece (the
         strains, the densities, the chain rules of ddg.energies): the reference the one-call
-        assembly is tested against (tests/test_compiled_newton.py), and what a model without a
+        assembly is tested against (tests/ddg/solve/test_compiled_newton.py), and what a model without a
         one-call assembly (assembly_args None) evaluates."""
         hessian = hessian and gradient
         x = q[self.node_dofs]

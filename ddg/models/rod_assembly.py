@@ -17,7 +17,7 @@ add_stretched_stencil_terms), Wunderlich's pairs of stencils (ddg.energies.wunde
 terms by rod_curvature.add_pair_cross_terms), and the cross-section as a field (ddg.energies.
 cross_section: Eq. X's density, Eq. V's torsion-warping and Eq. X's constant bending form). The
 models' piecewise composition (RodModel.evaluate_piecewise, ddg.models.wide_ribbons) is the
-reference this is tested against (tests/test_compiled_newton.py).
+reference this is tested against (tests/ddg/solve/test_compiled_newton.py).
 
 `rod_energy(q, state, args, want_gradient, want_hessian, grad, band)`: state = the committed
 (tangents, d1, m_ref); args = the model's constants (RodModel.assembly_args); grad (n,) and the

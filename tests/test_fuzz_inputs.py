@@ -107,7 +107,7 @@ DDG_ENTRY_POINTS = (
 VALIDATION_ENTRY_POINTS = (
     ("validation.score", None, "score_results"),
     ("validation.score", None, "write_template"),
-    ("validation.error_map", None, "build"),
+    ("validation.error_map.command", None, "build"),
     ("validation.report", None, "build_report"),
 )
 FEM_ENTRY_POINTS = (

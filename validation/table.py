@@ -138,3 +138,9 @@ class FigureData:
 
     def records(self) -> list[dict]:
         return [dict(zip(self.columns, row)) for row in self.rows]
+
+
+def records_figure(name: str, kind: str, caption: str, data: list[dict], marks: dict | None = None) -> FigureData:
+    """A figure whose CSV is a table's rows (dicts of the same keys, in order)."""
+    return FigureData(name, kind, caption, list(data[0].keys()) if data else ["model"],
+                      [list(d.values()) for d in data], marks or {})

@@ -159,8 +159,14 @@ def run(args) -> int:
     from ddg.output.interrupts import terminate_as_interrupt
 
     terminate_as_interrupt()  # SIGTERM too: the run in progress is written "interrupted", the table rewritten
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     try:
         if not args.table_only:
             for slenderness in SLENDERNESSES:

@@ -149,8 +149,14 @@ def run(args) -> int:
     bad = [s for s in args.slenderness if not 20.0 <= s <= 1e5]
     if bad:
         refuse(f"--slenderness {bad[0]:g} is outside [20, 1e5]")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     for s in args.slenderness:
         for model, name, resolution, across in runs(s):
             folder = run_folder(out, s, model, name)

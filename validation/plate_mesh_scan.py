@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import csv
 import math
+import sys
 import time
 from pathlib import Path
 
@@ -71,8 +72,14 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     """Each mesh of the range not yet in OUT's CSV run, the CSV and the table rewritten after each."""
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     name = f"mesh_scan_W{args.width_ratio:.4g}" + ("_equilateral" if args.equilateral else "")
     done = {}
     if (out / f"{name}.csv").exists():

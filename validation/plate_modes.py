@@ -23,6 +23,7 @@ order of |1 - ratio| over the whole width).
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -215,9 +216,17 @@ def add_arguments(parser) -> None:
 
 
 def run(args) -> int:
-    """The study (every width, mesh and mode), its files and a line per fitted order."""
+    """--out checked, then the study (every width, mesh and mode), its files and a line per fitted order."""
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     rows, orders = study()
-    write(Path(args.out), rows, orders)
+    write(out, rows, orders)
     for o in orders:
         print(f"{o['mesh']:11s} W/L {o['width_ratio']:.4g} {o['mode']:17s} whole {o['finest_whole_width']:.4f} "
               f"(order {o['order_whole_width']:.2f}) interior {o['finest_interior']:.4f}", flush=True)

@@ -37,7 +37,7 @@ ENOUGH_COLUMNS = ["compression_ratio", "width_ratio", "slenderness", "on_dW1", "
 
 
 def error_map_rows(path: Path | None = None) -> list[dict]:
-    """The committed error map (data/error_map/error_map.csv, validation/error_map.py), [] if absent."""
+    """The committed error map (data/error_map/error_map.csv, validation/error_map/), [] if absent."""
     from ..error_map import read_table
     from ..reference import ROOT
 

@@ -5,8 +5,9 @@ ribbon-regularisation; `python -m validation --help` lists them, `python -m vali
 from __future__ import annotations
 
 from .cli import main
+from .report import check_report_inputs
 
-__all__ = ["main"]
+__all__ = ["check_report_inputs", "main"]
 
 if __name__ == "__main__":
     raise SystemExit(main())

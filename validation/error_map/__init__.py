@@ -56,6 +56,7 @@ from __future__ import annotations
 from ddg.advise import QUANTITIES
 
 from ..claims import THRESHOLD_BAND
+from ..figures.error_map import FAMILY_MARKERS
 from ..reference import FEM_GOLD, ROOT
 from ..table import Table
 from .command import add_arguments, main, run
@@ -65,18 +66,18 @@ from .plots import figures
 from .readme_writer import held_out_section, readme
 from .rows import (COLUMNS, CSV_NAME, FAILED, KEY, REFERENCE_PATH_SLACK, RULES_VERSION, cheapest_within,
                    combined_error, is_current, open_table, put_row, read_table, row_errors, within)
-from .scenes import (NARROW, NARROW_SLENDERNESS, PLATE_MODELS, RIBBON_RESOLUTIONS, ROD_RESOLUTIONS, UNREAD_STUDY_KEYS,
-                     ReferenceScene, StoredMesh, check_selection, map_models, missing_scenes, reference_scenes,
-                     rod_family, study_hash)
+from .scenes import (HELD_OUT_SCENES, MAP_SCENES, NARROW, NARROW_SLENDERNESS, NEW_MAP_SCENES, PLATE_MODELS,
+                     RIBBON_RESOLUTIONS, ROD_RESOLUTIONS, UNREAD_STUDY_KEYS, ReferenceScene, StoredMesh,
+                     check_selection, map_models, missing_scenes, reference_scenes, rod_family, study_hash)
 
 #: The old private name of scenes.study_hash, which tests import from here.
 _study_hash = study_hash
 
-__all__ = ["COLUMNS", "CSV_NAME", "FAILED", "FEM_GOLD", "HELD_OUT_FIRST", "HELD_OUT_SECOND", "KEY", "MAX_TIMEOUT",
-           "NARROW", "NARROW_SLENDERNESS", "PLATE_MODELS", "QUANTITIES", "REFERENCE_PATH_SLACK", "RIBBON_RESOLUTIONS",
-           "ROD_RESOLUTIONS", "ROOT", "RULES_VERSION", "RUN_TIMEOUT", "ReferenceScene", "StoredMesh",
-           "THRESHOLD_BAND", "TOLERANCES", "Table", "UNREAD_STUDY_KEYS", "add_arguments", "build", "check_selection",
-           "cheapest_within", "combined_error", "figures", "held_out_check", "held_out_section", "held_out_targets",
-           "is_current", "load_rows", "main", "map_models", "missing_scenes", "open_table", "put_row", "read_table",
-           "readme", "reference_scenes", "rod_family", "row_errors", "run", "run_row", "stored_row", "study_hash",
-           "within"]
+__all__ = ["COLUMNS", "CSV_NAME", "FAILED", "FAMILY_MARKERS", "FEM_GOLD", "HELD_OUT_FIRST", "HELD_OUT_SCENES",
+           "HELD_OUT_SECOND", "KEY", "MAP_SCENES", "MAX_TIMEOUT", "NARROW", "NARROW_SLENDERNESS", "NEW_MAP_SCENES",
+           "PLATE_MODELS", "QUANTITIES", "REFERENCE_PATH_SLACK", "RIBBON_RESOLUTIONS", "ROD_RESOLUTIONS", "ROOT",
+           "RULES_VERSION", "RUN_TIMEOUT", "ReferenceScene", "StoredMesh", "THRESHOLD_BAND", "TOLERANCES", "Table",
+           "UNREAD_STUDY_KEYS", "add_arguments", "build", "cheapest_within", "check_selection", "combined_error",
+           "figures", "held_out_check", "held_out_section", "held_out_targets", "is_current", "load_rows", "main",
+           "map_models", "missing_scenes", "open_table", "put_row", "read_table", "readme", "reference_scenes",
+           "rod_family", "row_errors", "run", "run_row", "stored_row", "study_hash", "within"]

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..table import FigureData
+from ..table import FigureData, fraction
 from .diagnostics import (STABILITY_CATEGORIES, STABILITY_COLORS, convergence, pareto, speed_accuracy,
                           stability_category, stability_map)
 from .error_map import FAMILY_MARKERS, enough_map, family_marker, map_speed_accuracy
@@ -22,7 +22,7 @@ from .style import COLORS, MARKERS, pyplot
 
 __all__ = ["A11_STYLES", "BAND_COLORS", "COLORS", "DRAW", "FAMILY_MARKERS", "MARKERS", "PHASE_SHADES",
            "STABILITY_CATEGORIES", "STABILITY_COLORS", "centerline_error", "centerline_error_field", "convergence",
-           "curvature_profiles", "deformed_plates", "draw", "elastica", "enough_map", "family_marker",
+           "curvature_profiles", "deformed_plates", "draw", "elastica", "enough_map", "family_marker", "fraction",
            "map_speed_accuracy", "pareto", "poisson", "sadowsky_a11", "save", "save_png", "shear_curves",
            "shear_force", "snapshots", "speed_accuracy", "stability_category", "stability_map", "thresholds",
            "wide_ribbons"]

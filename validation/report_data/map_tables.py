@@ -6,6 +6,8 @@ from pathlib import Path
 
 from ddg.output.io import finite_float
 
+from ..error_map.rows import cheapest_within, combined_error, read_table
+from ..reference import ROOT
 from ..studies import COMPRESSIONS, WIDTHS_GOLD
 from ..table import FigureData
 
@@ -13,23 +15,17 @@ from ..table import FigureData
 #: ribbons' default M = 101, the rod's paper M = 100); the plate at its study's finest mesh.
 WIDE_MODELS = (("rod", "M100"), ("ribbon", "M101"), ("ribbon-sano-wada", "M101"), ("ribbon-trapeze", "M101"),
                ("ribbon-cross-section", "M101"), ("ribbon-wunderlich", "M101"))
-
-
-#: Tolerance (units of L) of the "cheapest model within" table: the issue's 1 %.
-ENOUGH_TOLERANCE = 0.01
-
-
 WIDE_COLUMNS = ["compression_ratio", "width_ratio", "model", "resolution", "dW1_over_L", "dW2_over_L",
                 "ref_dW1", "ref_dW2", "dW1_error", "dW2_error", "H_mid_error", "wall_time_s", "reason"]
+#: Tolerance (units of L) of the "cheapest model within" table: 1 % of L.
+ENOUGH_TOLERANCE = 0.01
+#: The further tolerances of the "which model is enough" table (the map per tolerance).
+ENOUGH_MORE_TOLERANCES = (0.02, 0.05)
 
 
 def enough_column(tolerance: float) -> str:
     """The enough table's column of the cheapest model within `tolerance` on all three quantities."""
     return f"on_all_three_{tolerance:g}".replace(".", "_")
-
-
-#: The further tolerances of the "which model is enough" table (issue 32: the map per tolerance).
-ENOUGH_MORE_TOLERANCES = (0.02, 0.05)
 
 
 ENOUGH_COLUMNS = ["compression_ratio", "width_ratio", "slenderness", "on_dW1", "on_dW1_bound", "on_all_three",
@@ -38,9 +34,6 @@ ENOUGH_COLUMNS = ["compression_ratio", "width_ratio", "slenderness", "on_dW1", "
 
 def error_map_rows(path: Path | None = None) -> list[dict]:
     """The committed error map (data/error_map/error_map.csv, validation/error_map/), [] if absent."""
-    from ..error_map import read_table
-    from ..reference import ROOT
-
     path = Path(path) if path is not None else ROOT / "data" / "error_map" / "error_map.csv"
     return read_table(path) if path.exists() else []
 
@@ -92,8 +85,6 @@ def enough_table(rows: list[dict], tolerance: float = ENOUGH_TOLERANCE) -> list[
     (validation.error_map.cheapest_within), with its bound and wall time; "none" where none is; and
     the cheapest on all three at each of ENOUGH_MORE_TOLERANCES (columns enough_column(tolerance):
     on_all_three_0_02, ...)."""
-    from ..error_map import cheapest_within, combined_error
-
     out = []
     keys = sorted({(float(r["compression_ratio"]), float(r["width_ratio"]), float(r["slenderness"])) for r in rows},
                   key=lambda k: (-k[0], k[1], k[2]))

@@ -30,7 +30,7 @@ def speed_accuracy(results, study_specs, golds, benchmark: Path = SPEED_BENCHMAR
     (its gold study and data/fem_fine) and the speed-accuracy benchmark's entries too. Returns
     (rows, reference).
 
-    With the FEM's mesh study of the scene (issue 29: not a single run), the reference is its
+    With the FEM's mesh study of the scene (not a single run), the reference is its
     converged values: the dW1 error is the distance to the converged dW1, the curve error the
     largest distance to the converged H_mid/L curve 0.02 away from the converged thresholds
     (Study.curve_error, without its bar: the reference text states the bars). A benchmark entry's

@@ -651,6 +651,12 @@ VALIDATION_MAINS = (("validation.benchmark", "--out"), ("validation.error_map", 
                     ("validation.paper_figures", "--out"), ("validation.plate_gold", "--levels=x"),
                     ("validation.plate_mesh_scan", "--triangles=1"), ("validation.plate_modes", "--out"),
                     ("validation.ribbon_regularisation", "--out"), ("validation.wide_check", "--rows=x"))
+#: The subcommand of `python -m validation` each module of VALIDATION_MAINS is (validation/cli.py).
+SUBCOMMANDS = {"validation.benchmark": "benchmark", "validation.error_map": "error-map",
+               "validation.locking": "locking", "validation.narrow_limit": "narrow-limit",
+               "validation.paper_figures": "paper-figures", "validation.plate_gold": "plate-gold",
+               "validation.plate_mesh_scan": "plate-mesh-scan", "validation.plate_modes": "plate-modes",
+               "validation.ribbon_regularisation": "ribbon-regularisation", "validation.wide_check": "wide-check"}
 #: A results file for `score` (validation/score.py's format): header and one scene.
 RESULTS_HEADER = ("kind,compression_ratio,width_ratio,slenderness,poisson_ratio,dW1_over_L,dW2_over_L,dW_over_L,"
                   "H_mid_over_L\n")
@@ -716,6 +722,21 @@ def issue47_bad_cases() -> list[Case]:
                 f"'{value}'" if short != "plate_mesh_scan" else "--triangles")
     add("validation.narrow_limit-slenderness-5", "validation.narrow_limit", ("--out={out}", "--slenderness=5"),
         "--slenderness", "5")
+    # 6. the same commands spelt as subcommands (python -m validation <command>): one bad value each, the
+    #    commands without a bad value of their own given a regular file as --out
+    for module, option in VALIDATION_MAINS:
+        command = SUBCOMMANDS[module]
+        if option == "--out":
+            add(f"validation-{command}-out-file", "validation", (command, "--out={tmp}/file.txt"), "--out",
+                "file.txt")
+        else:
+            name, value = option.split("=")
+            add(f"validation-{command}-{name.lstrip('-')}-{value}", "validation", (command, "--out={out}", option),
+                "arguments", f"'{value}'" if command != "plate-mesh-scan" else "--triangles")
+    add("validation-error-map-only-spaghetti", "validation", ("error-map",) + ERROR_MAP + ("--only=spaghetti",),
+        "--only", "spaghetti")
+    add("validation-narrow-limit-slenderness-5", "validation", ("narrow-limit", "--out={out}", "--slenderness=5"),
+        "--slenderness", "5")
     return cases
 
 
@@ -725,7 +746,9 @@ def issue47_valid_cases() -> list[Case]:
     cases = [Case(f"valid-{label}", prog, argv, "base", ACCEPT) for label, prog, argv in (
         ("ddg-sweep", "ddg", SWEEP), ("validation-score", "validation", SCORE),
         ("validation.error_map", "validation.error_map", ERROR_MAP),
-        ("validation.plate_gold", "validation.plate_gold", PLATE_GOLD), ("validation-report", "validation", REPORT))]
+        ("validation.plate_gold", "validation.plate_gold", PLATE_GOLD), ("validation-report", "validation", REPORT),
+        ("validation-error-map", "validation", ("error-map",) + ERROR_MAP),
+        ("validation-plate-gold", "validation", ("plate-gold",) + PLATE_GOLD))]
     cases.append(Case("valid-ddg-simulate-rod-env-DDG_BLAS_THREADS-256", "ddg", ddg_simulate("rod"),
                       "DDG_BLAS_THREADS", ACCEPT, env=(("DDG_BLAS_THREADS", "256"),)))
     return cases

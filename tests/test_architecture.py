@@ -194,3 +194,31 @@ def test_ruff_is_clean():
         pytest.skip("ruff is not installed (requirements-dev.txt installs it)")
     done = subprocess.run([ruff, "check", *PACKAGES, "tests", "benchmarks"], cwd=ROOT, capture_output=True, text=True)
     assert done.returncode == 0, done.stdout[-3000:]
+
+
+def validation_rooms(graph: dict[str, set[str]]) -> dict[str, set[str]]:
+    """validation's rooms (its sub-packages and its top-level modules; the package itself and its
+    __main__ face the user) -> the rooms they import."""
+    def room(module: str) -> str | None:
+        parts = module.split(".")
+        if parts[0] != "validation" or module in ("validation", "validation.__main__"):
+            return None
+        return parts[1]
+
+    rooms: dict[str, set[str]] = {}
+    for module, targets in graph.items():
+        a = room(module)
+        if a is None:
+            continue
+        rooms.setdefault(a, set())
+        rooms[a] |= {b for b in map(room, targets) if b is not None and b != a}
+    return rooms
+
+
+def test_no_import_circles_between_validations_rooms():
+    """validation's rooms stand on each other one way: the table, the references and the estimates
+    below the claims, the benchmark, the error map, the scorecard and the figures; the report's data
+    above them; the command line (validation.cli) on top, imported by none of them."""
+    rooms = validation_rooms(import_graph()[0])
+    assert not cycles(rooms), cycles(rooms)
+    assert not [r for r, targets in rooms.items() if "cli" in targets]

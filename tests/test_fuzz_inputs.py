@@ -24,8 +24,9 @@ stops converging, never 2, never a traceback). A few bad cases also run as subpr
 exit code and output.
 
 Issue 47 item 3 ("every bad input answered") adds the validation command lines (`python -m
-validation score|report`, validation.error_map, validation.plate_gold and every other validation
-module with its own main; prog "validation" or the module's name), `ddg sweep` and run_sweep, the
+validation <command>` for every subcommand, and the old spellings validation.error_map,
+validation.plate_gold and every other validation module with its own main; prog "validation" or the
+module's name), `ddg sweep` and run_sweep, the
 scheduler of fem_reference gold, and DDG_BLAS_THREADS (Case.env). Each of those cases must also name
 the refused value in its one line (Case.names) and leave its temporary folder exactly as it was
 (Case.untouched: no --out created, an existing --out unchanged, no runs/ or cache/); a read that
@@ -107,7 +108,7 @@ DDG_ENTRY_POINTS = (
 VALIDATION_ENTRY_POINTS = (
     ("validation.score", None, "score_results"),
     ("validation.score", None, "write_template"),
-    ("validation.error_map", None, "build"),
+    ("validation.error_map.command", None, "build"),
     ("validation.report", None, "build_report"),
 )
 FEM_ENTRY_POINTS = (

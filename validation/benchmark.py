@@ -1,6 +1,7 @@
 """The published benchmark: the thresholds dW1/L and dW2/L of the paper's ten scenes with error
 bars, FEM shell against DDG plate, beside the paper's quoted values and the rod:
-`python -m validation.benchmark [--out data/benchmark] [--no-rod]`.
+`python -m validation benchmark [--out data/benchmark] [--no-rod]` (old spelling
+`python -m validation.benchmark`).
 
 The ten scenes are dL/L in {1/2, 1/4} x W/L in {1/20, 1/12, 1/6, 1/3, 1/2}, at the paper's strip
 (L = 0.15 m for dL/L = 1/2 and 0.10 m for 1/4, b = 0.127 mm: L/b = 1181 and 787;
@@ -13,10 +14,10 @@ difference in units of the combined error bar, the sum of the two). The rod's va
 own study on M = 50/100/200 elements (three runs of ddg.simulate per scene, a few seconds), stored in
 OUT/rod_thresholds.json after each scene and not rerun when present there (resumable; --no-rod
 computes none and uses the stored ones where the file exists); likewise the 1D model with its
-cross-section (ribbon-cross-section, issue 30) on M = 51/101/201 nodes, in
+cross-section (ribbon-cross-section) on M = 51/101/201 nodes, in
 OUT/cross_section_thresholds.json. Writes OUT/benchmark.csv (every
 column, with the meshes of each study) and OUT/benchmark.md (the table and its legend), and prints
-the table. Regenerate after a new mesh study: `.venv/bin/python -m validation.benchmark --out
+the table. Regenerate after a new mesh study: `.venv/bin/python -m validation benchmark --out
 data/benchmark`.
 """
 from __future__ import annotations
@@ -24,16 +25,16 @@ from __future__ import annotations
 import json
 import sys
 import time
-from fractions import Fraction
 from pathlib import Path
 
-from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, read_json_object, write_table_csv
 
 from .claims import threshold_agreement
+from .command_line import standalone
 from .estimates import Estimate, Study, load_study, study_from_runs
 from .reference import gold_name, paper_value
 from .studies import COMPRESSIONS, WIDTHS_GOLD
+from .table import fraction_label
 
 #: Elements along L of the rod's study on each scene.
 ROD_RESOLUTIONS = (50, 100, 200)
@@ -188,12 +189,6 @@ def rod_thresholds(out: Path, scenes=None, quiet: bool = True, model: str = "rod
     return stored
 
 
-def fraction_label(x: float) -> str:
-    """A ratio as the nearest fraction with denominator <= 100 ("1/12", "1/4", "3")."""
-    f = Fraction(float(x)).limit_denominator(100)
-    return f"{f.numerator}/{f.denominator}" if f.denominator != 1 else str(f.numerator)
-
-
 def _number(value, spec: str = "{:.4f}") -> str:
     return MISSING if value is None else spec.format(value)
 
@@ -261,21 +256,24 @@ def write_benchmark(out: Path, rows: list[dict]) -> None:
     atomic_write_text(out / "benchmark.md", text)
 
 
-def main(argv=None) -> int:
-    """The command line: rod thresholds (unless --no-rod), then the benchmark files and table."""
-    from ddg.geometry.strip import InputError
-    from ddg.output.io import check_output_directory
-
-    parser = OneLineParser(prog="python -m validation.benchmark", description=__doc__.split("\n")[0])
+def add_arguments(parser) -> None:
+    """The options of `python -m validation benchmark`."""
+    parser.description = __doc__.split("\n")[0]
     parser.add_argument("--out", default="data/benchmark", help="output directory (default data/benchmark)")
     parser.add_argument("--no-rod", action="store_true",
                         help="run no 1D model (rod, ribbon-cross-section); use their stored files in OUT where "
                              "they exist")
-    args = parser.parse_args(argv)
+
+
+def run(args) -> int:
+    """The command: rod thresholds (unless --no-rod), then the benchmark files and table."""
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
     try:
         out = check_output_directory(args.out, "--out")
     except InputError as exc:
-        print(f"error: {exc}")
+        print(f"error: {exc}", file=sys.stderr)
         return 2
     if args.no_rod:
         rods, crosses = read_json_object(out / ROD_FILE), read_json_object(out / CROSS_SECTION_FILE)
@@ -286,6 +284,11 @@ def main(argv=None) -> int:
     write_benchmark(out, rows)
     print(markdown_table(rows), end="")
     return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.benchmark [options]`: the same as `python -m validation benchmark [options]`."""
+    return standalone("benchmark", add_arguments, run, argv)
 
 
 if __name__ == "__main__":

@@ -201,7 +201,7 @@ def _curve(entries) -> Curve | None:
 def load_study(model: str, compression_ratio: float, width_ratio: float, root: Path | None = None,
                name: str | None = None) -> Study | None:
     """The stored study of `model` ("fem", "plate" or "plate-midedge") on a scene:
-    OUT/<scene>/richardson.json of `python -m fem_reference gold` or `python -m validation.plate_gold
+    OUT/<scene>/richardson.json of `python -m fem_reference gold` or `python -m validation plate-gold
     [--model plate-midedge]`; None without one. `name`: the scene folder when it is not the paper's
     strip (fem_reference.gold.scene_name with L/b, e.g. dL0.5_W0.05_Lb300)."""
     folder = Path(root or STUDY_ROOTS[model]) / (name or gold_name(compression_ratio, width_ratio))

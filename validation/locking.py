@@ -1,6 +1,6 @@
-"""Membrane locking of the mid-edge plate, measured (issue 29, item 1).
+"""Membrane locking of the mid-edge plate, measured.
 
-`python -m validation.locking --out data/midedge_locking [--fem]`
+`python -m validation locking --out data/midedge_locking [--fem]` (old spelling `python -m validation.locking`)
 
 A plate discretisation that locks stores spurious membrane energy when it bends: the thinner the
 plate, the more it stiffens, so its pitchfork U -> US comes late on coarse meshes. The study runs
@@ -30,8 +30,9 @@ import sys
 import time
 from pathlib import Path
 
-from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, finished_run_summary
+
+from .command_line import standalone
 
 WIDTH_RATIO, COMPRESSION_RATIO = 1 / 6, 0.5
 SLENDERNESSES = (300.0, 1181.1, 4000.0)
@@ -144,17 +145,28 @@ def _fmt(value, spec="{:.4f}"):
     return "-" if not isinstance(value, (int, float)) or isinstance(value, bool) else spec.format(value)
 
 
-def main(argv=None) -> int:
-    parser = OneLineParser(prog="python -m validation.locking", description=__doc__.split("\n")[0])
+def add_arguments(parser) -> None:
+    """The options of `python -m validation locking`."""
+    parser.description = __doc__.split("\n")[0]
     parser.add_argument("--out", default="data/midedge_locking")
     parser.add_argument("--fem", action="store_true", help="also the shell on 64 x 8 at each slenderness")
     parser.add_argument("--table-only", action="store_true", help="no run: rewrite the tables")
-    args = parser.parse_args(argv)
+
+
+def run(args) -> int:
+    """The study's runs (finished ones kept), then the tables; Ctrl-C or SIGTERM: the tables of what
+    is finished, exit 130."""
     from ddg.output.interrupts import terminate_as_interrupt
 
     terminate_as_interrupt()  # SIGTERM too: the run in progress is written "interrupted", the table rewritten
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     try:
         if not args.table_only:
             for slenderness in SLENDERNESSES:
@@ -173,6 +185,11 @@ def main(argv=None) -> int:
         return 130
     tabulate(out)
     return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.locking [options]`: the same as `python -m validation locking [options]`."""
+    return standalone("locking", add_arguments, run, argv)
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""The narrow strip against the rod (issue 16 item 5): is the narrow plate's and shell's dW2 below
+"""The narrow strip against the rod: is the narrow plate's and shell's dW2 below
 the rod's physics or discretisation?
 
 At W/L = 1/20, dL/L = 1/2 and the paper's L/b = 1181, W^2/(b L) = 2.95: a strip that wide relative
@@ -7,16 +7,17 @@ W^2/(b L)). A rod's normalised thresholds depend on L/b only through W/b (its in
 stiffness); a plate's and a shell's should approach the rod's as W^2/(b L) -> 0 at fixed W/L, if
 the gap is physics.
 
-`python -m validation.narrow_limit [--out data/narrow_limit] [--slenderness 1181.10236 300 100]`
-runs, at each L/b, the FEM shell (fem_reference simulate, 64 x 8 and 96 x 12 elements), the DDG
-plate (exactly equilateral meshes of 8 and 12 rows), the rod (M = 100, 200; it depends on L/b
-through its in-plane bending stiffness only, (W/b)^2 times its out-of-plane one) and the 1D model
-with its cross-section (ribbon-cross-section, M = 101, 201; issue 30) through the
-the default path (docs/guide/run_a_scene.rst: 40 compression and 120 shear steps to dW_max, no branch tracing) into
-OUT/Lb<L/b>/<model>_<mesh>/ (path.csv, summary.json; at the paper's L/b the FEM and plate runs are
-those of data/fem_gold and data/plate_gold), then writes OUT/narrow_limit.json and
-OUT/narrow_limit.md: dW1/L and dW2/L per model and mesh, with W^2/(b L). Resumable run by run
-(a finished run is kept); the FEM runs in a subprocess, so dolfinx stays inside fem_reference.
+`python -m validation narrow-limit [--out data/narrow_limit] [--slenderness 1181.10236 300 100]`
+(old spelling `python -m validation.narrow_limit`) runs, at each L/b, the FEM shell (fem_reference
+simulate, 64 x 8 and 96 x 12 elements), the DDG plate (exactly equilateral meshes of 8 and 12 rows),
+the rod (M = 100, 200; it depends on L/b through its in-plane bending stiffness only, (W/b)^2 times
+its out-of-plane one) and the 1D model with its cross-section (ribbon-cross-section, M = 101, 201)
+through the default path (docs/guide/run_a_scene.rst: 40 compression and 120 shear steps to dW_max,
+no branch tracing) into OUT/Lb<L/b>/<model>_<mesh>/ (path.csv, summary.json; at the paper's L/b the
+FEM and plate runs are those of data/fem_gold and data/plate_gold), then writes
+OUT/narrow_limit.json and OUT/narrow_limit.md: dW1/L and dW2/L per model and mesh, with W^2/(b L).
+Resumable run by run (a finished run is kept); the FEM runs in a subprocess, so dolfinx stays inside
+fem_reference.
 """
 from __future__ import annotations
 
@@ -26,8 +27,9 @@ import sys
 import time
 from pathlib import Path
 
-from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, finished_run_summary
+
+from .command_line import refuse, standalone
 
 WIDTH_RATIO = 1 / 20
 COMPRESSION_RATIO = 1 / 2
@@ -134,16 +136,27 @@ def write_table(out: Path, rows: list[dict]) -> None:
     atomic_write_text(out / "narrow_limit.md", "\n".join(lines) + "\n")
 
 
-def main(argv=None) -> int:
-    parser = OneLineParser(prog="python -m validation.narrow_limit", description=__doc__.split("\n\n")[0])
+def add_arguments(parser) -> None:
+    """The options of `python -m validation narrow-limit`."""
+    parser.description = __doc__.split("\n\n")[0]
     parser.add_argument("--out", default="data/narrow_limit")
     parser.add_argument("--slenderness", type=float, nargs="+", default=[PAPER_SLENDERNESS, 300.0, 100.0])
-    args = parser.parse_args(argv)
+
+
+def run(args) -> int:
+    """Every run at each L/b (finished ones kept), the table rewritten after each; an L/b outside
+    [20, 1e5] is refused as a parse error (one line, SystemExit(2)) before any folder is made."""
     bad = [s for s in args.slenderness if not 20.0 <= s <= 1e5]
     if bad:
-        parser.error(f"--slenderness {bad[0]:g} is outside [20, 1e5]")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+        refuse(f"--slenderness {bad[0]:g} is outside [20, 1e5]")
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     for s in args.slenderness:
         for model, name, resolution, across in runs(s):
             folder = run_folder(out, s, model, name)
@@ -155,6 +168,11 @@ def main(argv=None) -> int:
                   f"dW2/L {(summary or {}).get('dW2_over_L')}", flush=True)
             write_table(out, table(out, args.slenderness))
     return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.narrow_limit [options]`: the same as `python -m validation narrow-limit [options]`."""
+    return standalone("narrow-limit", add_arguments, run, argv)
 
 
 if __name__ == "__main__":

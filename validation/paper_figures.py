@@ -1,5 +1,6 @@
 """Data of the report's Fig. 9 (the deformed plates and the centreline approximation's error over
-the plate, Eq. 13): `python -m validation.paper_figures --out data/paper_figures`.
+the plate, Eq. 13): `python -m validation paper-figures --out data/paper_figures` (old spelling
+`python -m validation.paper_figures`).
 
 For W/L in FIG9_WIDTHS at dL/L = 1/2, the plate on FIG9_TRIANGLES triangles is followed along its
 stable path to each dW/L of FIG9_SHEARS (ddg.studies.curvature_studies.states_at_shears), and at every
@@ -101,13 +102,15 @@ def write_shapes(out: Path, **kw) -> list[Path]:
     return write_figure9(out, parts=("shapes",), **kw)
 
 
-def main(argv=None) -> int:
-    from ddg.cli_parser import OneLineParser  # one-line parse errors, exit 2
-
-    parser = OneLineParser(prog="python -m validation.paper_figures", description=__doc__.splitlines()[0])
+def add_arguments(parser) -> None:
+    """The options of `python -m validation paper-figures`."""
+    parser.description = __doc__.splitlines()[0]
     parser.add_argument("--out", default="data/paper_figures")
     parser.add_argument("--quiet", action="store_true")
-    args = parser.parse_args(argv)
+
+
+def run(args) -> int:
+    """Fig. 9's and Fig. 9a's files (write_figure9) after --out is checked."""
     from ddg.geometry.strip import InputError
     from ddg.output.io import check_output_directory
 
@@ -118,6 +121,13 @@ def main(argv=None) -> int:
         return 2
     write_figure9(Path(args.out), quiet=args.quiet)
     return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.paper_figures [options]`: the same as `python -m validation paper-figures [options]`."""
+    from .command_line import standalone
+
+    return standalone("paper-figures", add_arguments, run, argv)
 
 
 if __name__ == "__main__":

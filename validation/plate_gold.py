@@ -1,7 +1,8 @@
-"""Mesh studies of the DDG plate on the benchmark scenes (issue 16 item 2):
-`python -m validation.plate_gold --out data/plate_gold [--only NAME ...] [--levels K]
+"""Mesh studies of the DDG plate on the benchmark scenes:
+`python -m validation plate-gold --out data/plate_gold [--only NAME ...] [--levels K]
 [--model plate|plate-midedge] [--workers N | --scheduler ADDRESS] [--retries 2]` (the mid-edge
-plate on ghost-clamp meshes of the same rows, e.g. into data/midedge_gold).
+plate on ghost-clamp meshes of the same rows, e.g. into data/midedge_gold; old spelling
+`python -m validation.plate_gold`).
 
 Each of the ten scenes of fem_reference.gold (dL/L in {1/2, 1/4} x W/L in {1/20, 1/12, 1/6, 1/3,
 1/2}, L/b = 1181; with --only also the error map's scenes, fem_reference.gold.MAP_SCENES) is run
@@ -32,9 +33,9 @@ import sys
 import time
 from pathlib import Path
 
-from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, finished_run_summary, read_json_object
 
+from .command_line import standalone
 from .estimates import DDG_TOLERANCES, load_study  # DDG_TOLERANCES: also read from here by benchmarks/
 
 #: Rows of triangles across W on the coarsest mesh (a multiple of 8: 1.5 and 2.25 times it stay even).
@@ -214,16 +215,11 @@ def agreement_lines(out: Path, model: str) -> list[str]:
     return lines
 
 
-def main(argv=None) -> int:
-    from ddg.geometry.strip import InputError
-    from ddg.output.interrupts import deferred_signals, exit_code_of, signal_name_of, terminate_as_interrupt
-    from ddg.output.io import check_output_directory
-    from ddg.solve.blas_threads import requested_threads
+def add_arguments(parser) -> None:
+    """The options of `python -m validation plate-gold`."""
     from ddg.sweep import cluster
-    from ddg.sweep.grid import code_version
-    from fem_reference.gold import all_scenes, scenes
 
-    parser = OneLineParser(prog="python -m validation.plate_gold", description=__doc__.split("\n")[0])
+    parser.description = __doc__.split("\n")[0]
     parser.add_argument("--out", default="data/plate_gold")
     parser.add_argument("--only", nargs="*", default=None)
     parser.add_argument("--levels", type=int, default=LEVELS)
@@ -232,7 +228,19 @@ def main(argv=None) -> int:
     parser.add_argument("--studies-only", action="store_true",
                         help="no run: rewrite each selected scene's study and the index from its finished runs")
     cluster.add_options(parser)  # --workers, --scheduler, --retries: the runs are Dask tasks, as the sweep's
-    args = parser.parse_args(argv)
+
+
+def run(args) -> int:
+    """Every option checked before any folder is made, then the selected scenes' runs as Dask tasks
+    (module docstring), each scene's study and the index rewritten as each run ends."""
+    from ddg.geometry.strip import InputError
+    from ddg.output.interrupts import deferred_signals, exit_code_of, signal_name_of, terminate_as_interrupt
+    from ddg.output.io import check_output_directory
+    from ddg.solve.blas_threads import requested_threads
+    from ddg.sweep import cluster
+    from ddg.sweep.grid import code_version
+    from fem_reference.gold import all_scenes, scenes
+
     terminate_as_interrupt()  # SIGTERM too keeps the finished runs
     known = [name for name, _, _, _ in all_scenes()]
     paper = {name for name, _, _ in scenes()}
@@ -288,6 +296,11 @@ def main(argv=None) -> int:
               f"kept in {out}; a rerun computes only the other {len(tasks) - done}", file=sys.stderr)
         return exit_code_of(ran.interrupted)
     return log.exit_code
+
+
+def main(argv=None) -> int:
+    """`python -m validation.plate_gold [options]`: the same as `python -m validation plate-gold [options]`."""
+    return standalone("plate-gold", add_arguments, run, argv)
 
 
 if __name__ == "__main__":

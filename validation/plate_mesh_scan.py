@@ -1,24 +1,26 @@
 """dW1 of the DDG plate over every structured mesh in a range of sizes: the mesh trend against
-the jitter of the mesh's aspect rounding (issue 16 item 3).
+the jitter of the mesh's aspect rounding.
 
-`python -m validation.plate_mesh_scan [--width-ratio 0.5] [--triangles 1200 3400] [--equilateral]
-[--out data/plate_modes]` runs the plate (dL/L = 1/2, 20 compression steps, shear to 0.22 L in steps of 0.01 L: past dW1
-at W/L = 1/2, thresholds on, no branches) on each distinct structured mesh (n columns, n_y
-rows) whose target size lies in the range, and writes OUT/mesh_scan_W<W/L>.csv and .md with the
-triangles, h_y/W, the column spacing over that of equilateral triangles (the aspect) and dW1/L.
-With --equilateral the meshes are the exactly equilateral ones of the same n_y
-(ddg.geometry.plate_mesh.equilateral_columns; aspect 1, files ..._equilateral). Resumable:
-finished meshes are read back from the CSV.
+`python -m validation plate-mesh-scan [--width-ratio 0.5] [--triangles 1200 3400] [--equilateral]
+[--out data/plate_modes]` (old spelling `python -m validation.plate_mesh_scan`) runs the plate (dL/L
+= 1/2, 20 compression steps, shear to 0.22 L in steps of 0.01 L: past dW1 at W/L = 1/2, thresholds
+on, no branches) on each distinct structured mesh (n columns, n_y rows) whose target size lies in
+the range, and writes OUT/mesh_scan_W<W/L>.csv and .md with the triangles, h_y/W, the column spacing
+over that of equilateral triangles (the aspect) and dW1/L. With --equilateral the meshes are the
+exactly equilateral ones of the same n_y (ddg.geometry.plate_mesh.equilateral_columns; aspect 1,
+files ..._equilateral). Resumable: finished meshes are read back from the CSV.
 """
 from __future__ import annotations
 
 import csv
 import math
+import sys
 import time
 from pathlib import Path
 
-from ddg.cli_parser import OneLineParser
 from ddg.output.io import atomic_write_text, write_table_csv
+
+from .command_line import standalone
 
 COMPRESSION_RATIO = 0.5
 SHEAR_RATIO = 0.22
@@ -44,7 +46,7 @@ def meshes(width_ratio: float, low: int, high: int, step: int = 25,
     return sorted(seen.values())
 
 
-def run(width_ratio: float, target: int, equilateral: bool = False) -> dict:
+def run_mesh(width_ratio: float, target: int, equilateral: bool = False) -> dict:
     import ddg
     from ddg.geometry.plate_mesh import structured_mesh
 
@@ -59,15 +61,25 @@ def run(width_ratio: float, target: int, equilateral: bool = False) -> dict:
             "wall_time_s": time.perf_counter() - t0}
 
 
-def main(argv=None) -> int:
-    parser = OneLineParser(prog="python -m validation.plate_mesh_scan", description=__doc__.split("\n")[0])
+def add_arguments(parser) -> None:
+    """The options of `python -m validation plate-mesh-scan`."""
+    parser.description = __doc__.split("\n")[0]
     parser.add_argument("--width-ratio", type=float, default=0.5)
     parser.add_argument("--triangles", type=int, nargs=2, default=[1200, 3400])
     parser.add_argument("--equilateral", action="store_true", help="exactly equilateral meshes of the same n_y")
     parser.add_argument("--out", default="data/plate_modes")
-    args = parser.parse_args(argv)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+
+
+def run(args) -> int:
+    """Each mesh of the range not yet in OUT's CSV run, the CSV and the table rewritten after each."""
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     name = f"mesh_scan_W{args.width_ratio:.4g}" + ("_equilateral" if args.equilateral else "")
     done = {}
     if (out / f"{name}.csv").exists():
@@ -78,13 +90,19 @@ def main(argv=None) -> int:
         if (n, n_y) in done:
             rows.append(done[(n, n_y)])
             continue
-        measured = run(args.width_ratio, target, args.equilateral)
+        measured = run_mesh(args.width_ratio, target, args.equilateral)
         rows.append({"target": target, "n": n, "n_y": n_y, "h_y_over_W": 1.0 / n_y, "aspect": aspect, **measured})
         print(f"{target} -> {measured['triangles']} triangles, aspect {aspect:.4f}: dW1/L {measured['dW1_over_L']}",
               flush=True)
         _write(out, name, rows, args.width_ratio)
     _write(out, name, rows, args.width_ratio)
     return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.plate_mesh_scan [options]`: the same as `python -m validation plate-mesh-scan
+    [options]`."""
+    return standalone("plate-mesh-scan", add_arguments, run, argv)
 
 
 def _write(out: Path, name: str, rows: list[dict], width_ratio: float) -> None:

@@ -1,7 +1,8 @@
 """Where the DDG plate's first-order error can come from: its energies on exact smooth
-deformations, mode by mode, interior against edge rows (issue 16 item 3, first measurement).
+deformations, mode by mode, interior against edge rows.
 
-`python -m validation.plate_modes [--out data/plate_modes]` imposes on the structured meshes
+`python -m validation plate-modes [--out data/plate_modes]` (old spelling
+`python -m validation.plate_modes`) imposes on the structured meshes
 (ddg.geometry.plate_mesh.structured_mesh: the default, and the exactly equilateral one) one
 deformation at a time, each small enough to be
 linear (curvature 0.01/L, strain 1e-4), and compares the energy the plate's terms give
@@ -22,15 +23,17 @@ order of |1 - ratio| over the whole width).
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from ddg.cli_parser import OneLineParser
 from ddg.energies.hinge_bending import hinge_bending_energy
 from ddg.geometry.strip import Strip
 from ddg.models.plate import PlateModel
 from ddg.output.io import atomic_write_text, write_table_csv
+
+from .command_line import standalone
 
 WIDTH_RATIOS = (1 / 6, 1 / 2)
 TRIANGLES = (500, 2000, 8000, 32000)
@@ -206,16 +209,33 @@ def write(out: Path, rows: list[dict], orders: list[dict]) -> None:
     atomic_write_text(out / "modes.md", "\n".join(lines) + "\n")
 
 
-def main(argv=None) -> int:
-    parser = OneLineParser(prog="python -m validation.plate_modes", description=__doc__.split("\n")[0])
+def add_arguments(parser) -> None:
+    """The options of `python -m validation plate-modes`."""
+    parser.description = __doc__.split("\n")[0]
     parser.add_argument("--out", default="data/plate_modes")
-    args = parser.parse_args(argv)
+
+
+def run(args) -> int:
+    """--out checked, then the study (every width, mesh and mode), its files and a line per fitted order."""
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     rows, orders = study()
-    write(Path(args.out), rows, orders)
+    write(out, rows, orders)
     for o in orders:
         print(f"{o['mesh']:11s} W/L {o['width_ratio']:.4g} {o['mode']:17s} whole {o['finest_whole_width']:.4f} "
               f"(order {o['order_whole_width']:.2f}) interior {o['finest_interior']:.4f}", flush=True)
     return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.plate_modes [options]`: the same as `python -m validation plate-modes [options]`."""
+    return standalone("plate-modes", add_arguments, run, argv)
 
 
 if __name__ == "__main__":

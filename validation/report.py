@@ -4,27 +4,29 @@ Output in DIR: index.html (self-contained: figures embedded), report.md, figures
 .pdf with figures/<name>.csv (every number behind each figure), tables as CSV, and summary.json
 with the headline errors, the claims and the timings. Runs are cached in DIR/cache (validation/runs.py).
 
-The numbers are one ReportData object (validation/report_data.py); report.md and index.html are
+The numbers are one ReportData object (validation/report_data/); report.md and index.html are
 rendered from it by the Jinja2 templates in validation/templates/ (sentences.j2 words the verdicts
 of validation/verdicts.py for both), summary.json and the CSVs are written from it here.
 """
 from __future__ import annotations
 
-import csv
+import argparse
 import importlib
-import io
 import json
 import math
 import re
+import sys
 import time
 from pathlib import Path
 
 from ddg.output.io import atomic_write_text
 
 from . import figures
-from .report_data import FigureData, ReportData, collect, fraction
+from .command_line import standalone
+from .report_data import ReportData, collect
 from .runs import run_all
 from .studies import PROFILES, specs
+from .table import FigureData, fraction, write_csv
 from .verdicts import ClaimsVerdict, MaterialCheck, MeshTrend, PaperReading
 
 TEMPLATES = Path(__file__).resolve().parent / "templates"
@@ -135,15 +137,6 @@ def mesh_trend_sentence(points: list[tuple[int, float]], reference: float, name:
 
 
 # ---------------------------------------------------------------------------- writing
-def write_csv(path: Path, columns: list[str], rows: list[list]) -> None:
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(columns)
-    for row in rows:
-        writer.writerow(["" if (isinstance(v, float) and not math.isfinite(v)) else v for v in row])
-    atomic_write_text(path, buf.getvalue())
-
-
 def draw_figures(items: list[FigureData], out: Path) -> None:
     """OUT/figures/<name>.png, .pdf and .csv of every figure; the PNGs kept for the HTML."""
     for item in items:
@@ -183,7 +176,7 @@ def write_report(data: ReportData, out: Path) -> dict:
     """The tables' CSVs, report.md, index.html and summary.json of `data` in `out`; returns the summary."""
     for table in data.tables.values():
         if table.csv:
-            write_csv(out / f"{table.name}.csv", table.columns, [[r.get(c) for c in table.columns] for r in table.rows])
+            table.write(out / f"{table.name}.csv")
     atomic_write_text(out / "report.md", render_markdown(data))
     atomic_write_text(out / "index.html", render_html(data))
     result = summary(data)
@@ -208,3 +201,73 @@ def build_report(profile_name: str, out: Path, jobs: int = 1, progress: bool = T
     draw_figures(data.figures, out)
     data.timings.report_wall_time_s = time.perf_counter() - t0
     return write_report(data, out)
+
+
+# ---------------------------------------------------------------------------- the command
+def add_arguments(parser) -> None:
+    """The options of `python -m validation report`."""
+    parser.description = "Run the models on the paper's scenes and write DIR/index.html, report.md."
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--quick", dest="profile", action="store_const", const="quick",
+                       help="the default scenes with cached FEM gold data (a few minutes on 2 cores; default)")
+    group.add_argument("--full", dest="profile", action="store_const", const="full", help="every study (1-2 hours)")
+    group.add_argument("--smoke", dest="profile", action="store_const", const="smoke", help=argparse.SUPPRESS)
+    parser.add_argument("--out", default="out/validation", help="output directory (default out/validation)")
+    parser.add_argument("--jobs", type=int, default=2, help="worker processes for the model runs (default 2)")
+    parser.add_argument("--scheduler", default=None,
+                        help="an existing Dask scheduler for the runs, e.g. tcp://host:8786 (default: a local cluster)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def check_report_inputs(args) -> None:
+    """`report`'s options before any folder is made (a one-line ddg.InputError): --jobs within the
+    LocalCluster's bounds (ddg.sweep.cluster), DDG_BLAS_THREADS, and the scheduler the runs would use
+    (--scheduler, else DASK_SCHEDULER_ADDRESS) connected to once: an unreachable one leaves no --out.
+    Without dask the runs are made in this process (validation.runs.run_all says so), and no
+    scheduler is asked."""
+    from ddg.geometry.strip import InputError
+    from ddg.limits import check_integer
+    from ddg.solve.blas_threads import requested_threads
+    from ddg.sweep import cluster
+
+    check_integer("--jobs", args.jobs, 1, max(4 * cluster.cores(), 8),
+                  "worker processes for the runs; more than the cores share them")
+    requested_threads()
+    if args.scheduler is not None:
+        cluster.checked_options(args.scheduler, None, 0)
+    try:
+        cluster.require_dask()
+    except InputError:
+        return
+    if args.scheduler is not None:
+        cluster.check_scheduler(args.scheduler)
+    elif cluster.default_scheduler() is not None:
+        cluster.check_scheduler(cluster.default_scheduler(), "DASK_SCHEDULER_ADDRESS")
+
+
+def run(args) -> int:
+    """`python -m validation report`: every option checked, then the report (build_report); a bad
+    option or a missing extra is one line on stderr and exit 2."""
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        check_report_inputs(args)
+        check_output_directory(args.out, "--out")   # before any run: an existing file is one line, not a traceback
+        summary = build_report(args.profile or "quick", args.out, jobs=args.jobs, progress=not args.quiet,
+                               scheduler=args.scheduler)
+    except (MissingExtra, InputError) as exc:
+        sys.stderr.write(f"error: {exc}\n")
+        return 2
+    print(f"report: {args.out}/index.html ({summary['runs']} runs, {summary['report_wall_time_s']:.0f} s); "
+          f"claims failing: {summary['claims_failing'] or 'none'}")
+    return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.report [options]`: the same as `python -m validation report [options]`."""
+    return standalone("report", add_arguments, run, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,5 +1,6 @@
 """The effect of the Wunderlich ribbon's regularisation (ddg.energies.wunderlich) on its thresholds,
-`python -m validation.ribbon_regularisation --out data/ribbon_regularisation [--jobs N]`.
+`python -m validation ribbon-regularisation --out data/ribbon_regularisation` (old spelling
+`python -m validation.ribbon_regularisation`).
 
 Eq. (A.2) is singular at inflection points (eta = tau / k2 diverges where k2 = 0). The model
 regularises the ruling slope as Eq. (A.5) regularises Sadowsky's quartic term, eta = tau k2 /
@@ -131,12 +132,14 @@ def write_readme(out: Path, rows: list[dict]) -> None:
     atomic_write_text(out / "README.md", "\n".join(head + body) + "\n")
 
 
-def main(argv=None) -> int:
-    from ddg.cli_parser import OneLineParser  # one-line parse errors, exit 2
-
-    parser = OneLineParser(prog="python -m validation.ribbon_regularisation")
+def add_arguments(parser) -> None:
+    """The options of `python -m validation ribbon-regularisation`."""
+    parser.description = __doc__.split("\n")[0]
     parser.add_argument("--out", default="data/ribbon_regularisation")
-    args = parser.parse_args(argv)
+
+
+def run(args) -> int:
+    """Every case not yet in OUT's CSV run, the CSV rewritten after each, then the README."""
     from ddg.geometry.strip import InputError
     from ddg.output.io import check_output_directory
 
@@ -157,6 +160,14 @@ def main(argv=None) -> int:
         print(",".join(str(rows[-1][c]) for c in COLUMNS[:9]), flush=True)
     write_readme(out, rows)
     return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.ribbon_regularisation [options]`: the same as `python -m validation
+    ribbon-regularisation [options]`."""
+    from .command_line import standalone
+
+    return standalone("ribbon-regularisation", add_arguments, run, argv)
 
 
 if __name__ == "__main__":

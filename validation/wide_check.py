@@ -1,8 +1,8 @@
 """Which side is unconverged at W/L = 1/2: the mid-edge plate's U branch against the shell's
-(issue 29, item 3: "where they disagree, find which side is wrong").
+(where they disagree, which side is wrong).
 
-`python -m validation.wide_check --out data/midedge_wide [--rows 16 24 36 54] [--membranes psri full]
-[--no-anisotropic] [--table-only]`
+`python -m validation wide-check --out data/midedge_wide [--rows 16 24 36 54] [--membranes psri full]
+[--no-anisotropic] [--table-only]` (old spelling `python -m validation.wide_check`)
 
 At dL/L = 1/4, W/L = 1/2 (L/b = 1181) the mid-edge plate's dW1/L (0.0858/0.0874/0.0872 on 16/24/36
 rows) stays about 0.002 L above the FEM's converged 0.0853 +- 0.0002. This study follows the
@@ -26,8 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ddg.cli_parser import OneLineParser
 from ddg.output.io import StoredRun, atomic_write_text, finished_run_summary
+
+from .command_line import standalone
 
 WIDTH_RATIO, COMPRESSION_RATIO = 1 / 2, 1 / 4
 ROWS = (16, 24, 36, 54)
@@ -123,16 +124,22 @@ def write_tables(out: Path, fem_root: Path) -> dict:
     return summary
 
 
-def main(argv=None) -> int:
-    from ddg.geometry.strip import InputError
-    from ddg.output.io import check_output_directory
-    parser = OneLineParser(prog="python -m validation.wide_check", description=__doc__.split("\n\n")[0])
+def add_arguments(parser) -> None:
+    """The options of `python -m validation wide-check`."""
+    parser.description = __doc__.split("\n\n")[0]
     parser.add_argument("--out", default="data/midedge_wide")
     parser.add_argument("--rows", type=int, nargs="+", default=list(ROWS))
     parser.add_argument("--membranes", nargs="+", default=list(MEMBRANES))
     parser.add_argument("--no-anisotropic", action="store_true", help="without the ANISOTROPIC meshes")
     parser.add_argument("--table-only", action="store_true", help="no run: rewrite the table")
-    args = parser.parse_args(argv)
+
+
+def run(args) -> int:
+    """Every option checked before any folder is made, then the runs (finished ones kept) and the
+    table rewritten after each; Ctrl-C: the table of what finished, exit 130."""
+    from ddg.geometry.strip import InputError
+    from ddg.output.io import check_output_directory
+
     try:
         bad = [m for m in args.membranes if m not in MEMBRANES]
         if bad:
@@ -161,6 +168,11 @@ def main(argv=None) -> int:
         return 130
     write_tables(out, ROOT_FEM)
     return 0
+
+
+def main(argv=None) -> int:
+    """`python -m validation.wide_check [options]`: the same as `python -m validation wide-check [options]`."""
+    return standalone("wide-check", add_arguments, run, argv)
 
 
 if __name__ == "__main__":

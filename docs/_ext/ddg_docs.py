@@ -130,7 +130,7 @@ class BenchmarkScenes(_TableDirective):
 
 class ThresholdTable(_TableDirective):
     """`.. threshold-table:: dW1` (or dW2): the converged threshold of every model on the paper's ten
-    scenes, from data/benchmark/benchmark.csv (python -m validation.benchmark)."""
+    scenes, from data/benchmark/benchmark.csv (python -m validation benchmark)."""
     required_arguments = 1
     MODELS = (("fem", "FEM shell"), ("plate", "plate"), ("midedge", "mid-edge plate"), ("rod", "rod"),
               ("cross_section", "cross-section"))

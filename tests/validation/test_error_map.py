@@ -6,6 +6,9 @@ import numpy as np
 import pytest
 
 from validation import error_map as em
+from validation.error_map import command as map_command
+from validation.error_map import compute as map_compute
+from validation.error_map import rows as map_rows
 from validation.estimates import Curve, Estimate, MeshResult, Study
 
 ROOT = em.ROOT
@@ -57,16 +60,16 @@ def test_missing_thresholds_and_incomplete_runs_say_why_and_have_no_bound():
 
 def test_table_is_resumable_by_key_and_hashes(tmp_path):
     path = tmp_path / "map.csv"
-    table = em.Table(path)
+    table = em.open_table(path)
     row = {"scene": "dL0.5_W0.05_Lb1181", "model": "rod", "resolution": 50, "resolution_label": "M50",
            "source_hash": "a", "reference_hash": "r", "dW1_bound": 0.01}
-    table.put(row)
-    table.put({**row, "model": "ribbon", "resolution_label": "M51"})
-    again = em.Table(path)
-    assert again.current(("rod", "M50", "dL0.5_W0.05_Lb1181"), "a", "r")
-    assert not again.current(("rod", "M50", "dL0.5_W0.05_Lb1181"), "b", "r")     # other sources: recompute
-    assert not again.current(("rod", "M50", "dL0.5_W0.05_Lb1181"), "a", "s")     # other reference: recompute
-    again.put({**row, "source_hash": "b", "dW1_bound": 0.02})                    # replaces, never duplicates
+    em.put_row(table, row)
+    em.put_row(table, {**row, "model": "ribbon", "resolution_label": "M51"})
+    again = em.open_table(path)
+    assert em.is_current(again, ("rod", "M50", "dL0.5_W0.05_Lb1181"), "a", "r")
+    assert not em.is_current(again, ("rod", "M50", "dL0.5_W0.05_Lb1181"), "b", "r")     # other sources: recompute
+    assert not em.is_current(again, ("rod", "M50", "dL0.5_W0.05_Lb1181"), "a", "s")     # other reference: recompute
+    em.put_row(again, {**row, "source_hash": "b", "dW1_bound": 0.02})                    # replaces, never duplicates
     with open(path) as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == 2 and [r["dW1_bound"] for r in rows if r["model"] == "rod"] == ["0.02"]
@@ -81,14 +84,14 @@ def test_a_row_made_under_other_comparison_rules_is_recomputed(tmp_path, monkeyp
     path = tmp_path / "map.csv"
     row = {"scene": "dL0.5_W0.05_Lb1181", "model": "plate", "resolution": 8, "resolution_label": "R8",
            "source_hash": "a", "reference_hash": "r"}
-    em.Table(path).put(row)
-    assert em.Table(path).current(("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
-    monkeypatch.setattr(em, "RULES_VERSION", "next")
-    assert not em.Table(path).current(("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
+    em.put_row(em.open_table(path), row)
+    assert em.is_current(em.open_table(path), ("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
+    monkeypatch.setattr(map_rows, "RULES_VERSION", "next")
+    assert not em.is_current(em.open_table(path), ("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
     old = path.read_text().replace(",rules_version", "").replace(",2\n", "\n")
     path.write_text(old)
     monkeypatch.undo()
-    assert not em.Table(path).current(("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
+    assert not em.is_current(em.open_table(path), ("plate", "R8", "dL0.5_W0.05_Lb1181"), "a", "r")
 
 
 def _map_row(w, lb, model, label, wall, bound):
@@ -352,18 +355,19 @@ def test_a_failed_run_is_never_written_and_one_of_an_older_table_is_dropped(tmp_
     path = tmp_path / "map.csv"
     good = {"scene": "dL0.5_W0.05_Lb1181", "model": "rod", "resolution": 50, "resolution_label": "M50",
             "status": "complete", "source_hash": "a", "reference_hash": "r", "dW1_bound": 0.01}
-    table = em.Table(path)
-    assert table.put(good)
+    table = em.open_table(path)
+    assert em.put_row(table, good)
     before = path.read_text()
-    assert not table.put({**good, "status": em.FAILED, "source_hash": "b", "reason": "run failed: _Timeout"})
-    assert path.read_text() == before and em.Table(path).current(("rod", "M50", "dL0.5_W0.05_Lb1181"), "a", "r")
+    assert not em.put_row(table, {**good, "status": em.FAILED, "source_hash": "b", "reason": "run failed: _Timeout"})
+    assert path.read_text() == before and em.is_current(em.open_table(path), ("rod", "M50", "dL0.5_W0.05_Lb1181"),
+                                                        "a", "r")
     old = [{**{c: "" for c in em.COLUMNS}, **good, "model": "ribbon", "resolution_label": "M51",
             "status": em.FAILED}]
     with open(path, "a", newline="") as fh:   # an error row written before this rule
         csv.DictWriter(fh, fieldnames=em.COLUMNS).writerows(old)
-    again = em.Table(path)
+    again = em.open_table(path)
     assert [r["model"] for r in again.rows] == ["rod"]
-    assert again.put({**good, "resolution": 100, "resolution_label": "M100"})
+    assert em.put_row(again, {**good, "resolution": 100, "resolution_label": "M100"})
     assert {r["status"] for r in em.read_table(path)} == {"complete"} and len(em.read_table(path)) == 2
 
 
@@ -387,14 +391,14 @@ def test_a_run_that_fails_is_reported_not_written_and_the_command_exits_1(tmp_pa
                 "status": em.FAILED, "reason": f"run failed: _Timeout: the run took more than {timeout:g} s"}
 
     monkeypatch.setattr(cluster, "run_all", in_process)
-    monkeypatch.setattr(em, "run_row", failing)
-    monkeypatch.setattr(em, "rod_family", lambda: [("rod", (24,))])
-    monkeypatch.setattr(em, "figures", lambda rows, out: [])   # matplotlib: not what is tested here
+    monkeypatch.setattr(map_compute, "run_row", failing)
+    monkeypatch.setattr(map_compute, "rod_family", lambda: [("rod", (24,))])
+    monkeypatch.setattr(map_command, "figures", lambda rows, out: [])   # matplotlib: not what is tested here
     out = tmp_path / "map"
     committed = [r for r in committed_rows()
                  if (r["scene"], r["model"], r["resolution_label"]) == (scene, "rod", "M50")]
     older = {**committed[0], "resolution": "24", "resolution_label": "M24", "source_hash": "older sources"}
-    em.Table(out / em.CSV_NAME).put(older)
+    em.put_row(em.open_table(out / em.CSV_NAME), older)
     before = (out / em.CSV_NAME).read_text()
     code = em.main(["--out", str(out), "--only", "dL0.25_W0.05", "--models", "rod", "--workers", "1",
                     "--timeout", "5"])

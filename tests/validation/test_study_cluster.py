@@ -310,7 +310,7 @@ def test_error_map_runs_on_two_local_workers_then_on_an_existing_scheduler(tmp_p
         pytest.skip("the repository's FEM gold data (data/fem_gold) is not here")
     out = tmp_path / "map"
     args = ["--out", str(out), "--only", MAP_SCENE, "--models", "rod"]
-    monkeypatch.setattr(em, "rod_family", lambda: [("rod", (24, 32))])
+    monkeypatch.setattr(em.compute, "rod_family", lambda: [("rod", (24, 32))])
     assert em.main(args + ["--workers", "2"]) == 0
     err = capsys.readouterr().err
     assert sorted(line.split(":")[0] for line in err.splitlines() if line.startswith(MAP_ROW_SCENE)) == \
@@ -322,7 +322,7 @@ def test_error_map_runs_on_two_local_workers_then_on_an_existing_scheduler(tmp_p
     assert {r["source_hash"] for r in first} == {code_version()} and {r["status"] for r in first} == {"complete"}
     assert all(float(r["dW1_bound"]) > 0 for r in first) and (out / "README.md").exists()
 
-    monkeypatch.setattr(em, "rod_family", lambda: [("rod", (24, 32, 40))])
+    monkeypatch.setattr(em.compute, "rod_family", lambda: [("rod", (24, 32, 40))])
     assert em.main(args + ["--scheduler", scheduler]) == 0
     err = capsys.readouterr().err
     assert [line.split(":")[0] for line in err.splitlines() if line.startswith(MAP_ROW_SCENE)] == \
@@ -343,8 +343,8 @@ def test_ctrl_c_keeps_the_map_rows_written_with_exit_130(tmp_path, scheduler, re
     if not (em.FEM_GOLD / MAP_SCENE / "richardson.json").exists():
         pytest.skip("the repository's FEM gold data (data/fem_gold) is not here")
     out = tmp_path / "map"
-    monkeypatch.setattr(em, "rod_family", lambda: [("rod", (24, 32))])
-    monkeypatch.setattr(em, "run_row", map_held)
+    monkeypatch.setattr(em.compute, "rod_family", lambda: [("rod", (24, 32))])
+    monkeypatch.setattr(em.compute, "run_row", map_held)
     interrupt_once(out / em.CSV_NAME)   # written when the first row has been filed
     try:
         code = em.main(["--out", str(out), "--only", MAP_SCENE, "--models", "rod", "--scheduler", scheduler])
@@ -414,7 +414,7 @@ def test_a_scheduler_that_does_not_answer_is_one_line_and_exit_2(generator, tmp_
     from validation import error_map as em
 
     monkeypatch.setattr(C, "CONNECT_TIMEOUT_S", 1)
-    monkeypatch.setattr(em, "rod_family", lambda: [("rod", (24,))])
+    monkeypatch.setattr(em.compute, "rod_family", lambda: [("rod", (24,))])
     main, args = GENERATORS[generator]
     out = tmp_path / "out"
     assert main(["--out", str(out)] + args + ["--scheduler", "tcp://127.0.0.1:9"]) == 2

@@ -180,11 +180,11 @@ LEFT_ALONE = ["Eq. (6b)", "Eqs. (11a) and (11b)", "O(h^2)", "tolerance 1e-4 L", 
               "a mesh of [x0, x1] x [-W/2, W/2]", "shortens the free rod by 2h", "sqrt(3)/4 h", "dt = 0.01 s",
               "time_step (s): default 0.01 s", "1 mm/s", "damping 20 1/s", "w is measured along m2 at rest: "
               "m1 = +z", "arclength measured from the clamp point at s = 0",
-              "Continuum limit (Seung and Nelson 1988; measured in tests/test_plate_energies.py)",
+              "Continuum limit (Seung and Nelson 1988; measured in tests/ddg/energies/test_plate_energies.py)",
               "the 75 mm between the clamps", "b = 0.127 mm", "(Sano and Wada 2019)", "Figs. 9-10",
               "the angle is 3/2 times larger",
               "W^2 kappa / b -> 0 or W^2 tau / b -> 0", "(lambda_min = 0 on its U branch)", "(6M - 3 against 4M - 1)",
-              "bending Poisson ratio -1/3 (measured in tests/test_plate_energies.py)",
+              "bending Poisson ratio -1/3 (measured in tests/ddg/energies/test_plate_energies.py)",
               "bandwidth 10-200 (what that costs: docs/findings/measured.md)"]
 
 

@@ -106,7 +106,7 @@ def shear_force_figure(results, profile, golds, load=None) -> FigureData | None:
         "logarithmic beyond: the force grows without bound as dW approaches dW_max); dotted: dW1, dashed: dW2 of "
         "each model (from stability); shaded: the converged force of the FEM and plate mesh studies with its error "
         "bar, up to where all their meshes reached (claims plate_vs_fem_force, plate_vs_fem_own_material_force). "
-        "tests/test_shear_force.py checks the force against the derivative of the energy along the path.",
+        "tests/ddg/models/test_shear_force.py checks the force against the derivative of the energy along the path.",
         ["model", "compression_ratio", "width_ratio", "dW_over_L", "F_shear_norm", "error_bar"], rows,
         {"panels": scenes, "thresholds": thresholds})
 

@@ -14,7 +14,7 @@ from ..table import fraction_label
 
 #: Every release of the benchmark and the digest of the studies it was made from (benchmark_digest):
 #: a new or extended mesh study in data/fem_gold, or a new error-bar rule, is a new release.
-#: tests/test_score.py checks that the committed studies are BENCHMARK_VERSION's, so changed data cannot
+#: tests/validation/test_score.py checks that the committed studies are BENCHMARK_VERSION's, so changed data cannot
 #: keep an old version. What each release changed: docs/reference/benchmark.rst, "Releases".
 BENCHMARK_RELEASES = {
     "2026.11-1": "e7a809c515e9c367",   # 28 scenes

@@ -11,7 +11,7 @@ import pytest
 
 from validation import cli
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 COMMANDS = cli.commands()
 #: The old spelling of each subcommand: the module `python -m` ran.
 OLD_SPELLING = {"report": "validation.report", "score": "validation.score", "benchmark": "validation.benchmark",

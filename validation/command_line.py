@@ -24,3 +24,16 @@ def refuse(message: str):
     """A bad option found after parsing, refused as a parse error is: one line on stderr, SystemExit(2)."""
     sys.stderr.write(f"error: {' '.join(str(message).split())}\n")
     raise SystemExit(EXIT_BAD_INPUT)
+
+
+def output_folder(path):
+    """The command's --out folder (ddg.output.io.check_output_directory), or None after one line on
+    stderr where it is a file or cannot be written: the caller returns exit 2 before any work."""
+    from ddg.limits import InputError
+    from ddg.output.io import check_output_directory
+
+    try:
+        return check_output_directory(path, "--out")
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return None

@@ -32,7 +32,7 @@ from pathlib import Path
 
 from ddg.output.io import atomic_write_text, finished_run_summary
 
-from .command_line import standalone
+from .command_line import output_folder, standalone
 
 WIDTH_RATIO, COMPRESSION_RATIO = 1 / 6, 0.5
 SLENDERNESSES = (300.0, 1181.1, 4000.0)
@@ -159,13 +159,8 @@ def run(args) -> int:
     from ddg.output.interrupts import terminate_as_interrupt
 
     terminate_as_interrupt()  # SIGTERM too: the run in progress is written "interrupted", the table rewritten
-    from ddg.geometry.strip import InputError
-    from ddg.output.io import check_output_directory
-
-    try:
-        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    out = output_folder(args.out)   # a file or an unwritable folder: one line, exit 2
+    if out is None:
         return 2
     try:
         if not args.table_only:

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from ddg.output.io import atomic_write_text, finished_run_summary
 
-from .command_line import refuse, standalone
+from .command_line import output_folder, refuse, standalone
 
 WIDTH_RATIO = 1 / 20
 COMPRESSION_RATIO = 1 / 2
@@ -149,13 +149,8 @@ def run(args) -> int:
     bad = [s for s in args.slenderness if not 20.0 <= s <= 1e5]
     if bad:
         refuse(f"--slenderness {bad[0]:g} is outside [20, 1e5]")
-    from ddg.geometry.strip import InputError
-    from ddg.output.io import check_output_directory
-
-    try:
-        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    out = output_folder(args.out)   # a file or an unwritable folder: one line, exit 2
+    if out is None:
         return 2
     for s in args.slenderness:
         for model, name, resolution, across in runs(s):

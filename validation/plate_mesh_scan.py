@@ -14,13 +14,12 @@ from __future__ import annotations
 
 import csv
 import math
-import sys
 import time
 from pathlib import Path
 
 from ddg.output.io import atomic_write_text, write_table_csv
 
-from .command_line import standalone
+from .command_line import output_folder, standalone
 
 COMPRESSION_RATIO = 0.5
 SHEAR_RATIO = 0.22
@@ -72,13 +71,8 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     """Each mesh of the range not yet in OUT's CSV run, the CSV and the table rewritten after each."""
-    from ddg.geometry.strip import InputError
-    from ddg.output.io import check_output_directory
-
-    try:
-        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    out = output_folder(args.out)   # a file or an unwritable folder: one line, exit 2
+    if out is None:
         return 2
     name = f"mesh_scan_W{args.width_ratio:.4g}" + ("_equilateral" if args.equilateral else "")
     done = {}

@@ -23,7 +23,6 @@ order of |1 - ratio| over the whole width).
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +32,7 @@ from ddg.geometry.strip import Strip
 from ddg.models.plate import PlateModel
 from ddg.output.io import atomic_write_text, write_table_csv
 
-from .command_line import standalone
+from .command_line import output_folder, standalone
 
 WIDTH_RATIOS = (1 / 6, 1 / 2)
 TRIANGLES = (500, 2000, 8000, 32000)
@@ -217,13 +216,8 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     """--out checked, then the study (every width, mesh and mode), its files and a line per fitted order."""
-    from ddg.geometry.strip import InputError
-    from ddg.output.io import check_output_directory
-
-    try:
-        out = check_output_directory(args.out, "--out")   # a file or an unwritable folder: one line, exit 2
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    out = output_folder(args.out)   # a file or an unwritable folder: one line, exit 2
+    if out is None:
         return 2
     rows, orders = study()
     write(out, rows, orders)

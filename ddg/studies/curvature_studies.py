@@ -18,7 +18,10 @@ from ..models.names import PLATE, RIBBON, ROD
 from ..models.ribbon import RIBBON_INITS, RibbonModel
 from ..models.rod import RodModel
 from ..output.io import atomic_write_text
-from ..solve.continuation import ContinuationOptions, PathFollower, relax_from
+from ..protocol.driver import Loading, Run, follow
+from ..protocol.steppers import StaticStepper
+from ..solve.continuation import ContinuationFailure, ContinuationOptions, relax_from
+from ..solve.state import Snapshot
 
 
 def write_curvatures_csv(path, records: list[dict]) -> None:
@@ -39,7 +42,9 @@ def write_curvatures_csv(path, records: list[dict]) -> None:
 def states_at_shears(model_name: str, strip, compression_ratio: float, shear_ratios, resolution=None, *,
                      ribbon_init: str = "direct", zeta=None, max_step: float = 0.02, options=None, mesh=None):
     """Run compression, then shear through the requested dW/L in increasing order (recorded steps
-    of at most max_step L, quasi-static), yielding (model, state) at each requested dW/L.
+    of at most max_step L, quasi-static, through the protocol's one driver, ddg.protocol.driver),
+    yielding (model, state) at each requested dW/L, the model's reference frames those of the state.
+    A path that stops raises ContinuationFailure with the stepper's message.
 
     model_name: rod, plate, ribbon; for the ribbon ribbon_init="rod" follows the rod and relaxes
     each requested state under the ribbon energy (ddg.solve.continuation.relax_from)."""
@@ -63,22 +68,43 @@ def states_at_shears(model_name: str, strip, compression_ratio: float, shear_rat
     else:
         driver = make_model(model_name, strip, resolution, mesh)
         ribbon = None
-    follower = PathFollower(driver, options)
+    # the recorded loads: compression in steps of at most max_step L, then shear through each
+    # requested dW/L in steps of at most max_step L; row[i] is the recorded row a request reads
+    # (the last compression row where it asks for no shear beyond the previous one)
     dL = compression_ratio * L
-    state = follower.rest()
     steps = max(1, int(np.ceil(compression_ratio / max_step)))
-    for k in range(1, steps + 1):
-        state = follower.start_compression(dL * k / steps) if k == 1 else follower.advance(state, dL * k / steps, 0.0)
-    current = 0.0
+    shears, wanted, current = [], [], 0.0
     for ratio in shear_ratios:
         n = int(np.ceil((ratio - current) / max_step - 1e-9))
-        for k in range(1, n + 1):
-            state = follower.advance(state, dL, L * (current + (ratio - current) * k / n))
+        shears += [L * (current + (ratio - current) * k / n) for k in range(1, n + 1)]
+        wanted.append(steps + len(shears))  # rows: the rest, `steps` compressions, the shears so far
         current = ratio
+    loading = Loading(tuple(dL * k / steps for k in range(1, steps + 1)), tuple(shears), dL)
+    kept: dict[int, Snapshot] = {}
+
+    def keep(stage, state, row, rows=[0]):  # noqa: B006  (the count of rows recorded so far)
+        if rows[0] in wanted:
+            kept[rows[0]] = Snapshot.take(driver, state)
+        rows[0] += 1
+
+    def observe(stage, state):  # no row is written: the driver reads H_mid after compression only
+        return {"H_mid_over_L": None}
+
+    outcome = follow(Run(StaticStepper(driver, options, folds=False), loading, observe=observe, summary={},
+                         listeners=(keep,)))
+    if outcome.interrupted is not None:
+        raise outcome.interrupted
+    if outcome.error is not None:
+        raise outcome.error
+    if outcome.stopped is not None:
+        raise ContinuationFailure(outcome.stopped)
+    for row in wanted:
+        snapshot = kept[row]
+        driver.restore_frames(snapshot.frames)
         if relax is not None:
-            yield ribbon, relax(state)
+            yield ribbon, relax(snapshot.state)
         else:
-            yield driver, state
+            yield driver, snapshot.state
 
 
 # ---------------------------------------------------------------------- thickness study (Figs. A.13-A.14)

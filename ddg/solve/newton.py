@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..limits import InputError, check_option  # noqa: F401  (check_option: options' fields)
-from . import compiled_newton
+from . import compiled_newton, trust_region
 
 
 #: Descending from a saddle to a stable branch (minimize=True) slides along a soft, curved
@@ -107,9 +107,9 @@ def newton(model, q: np.ndarray, options: NewtonOptions | None = None, *, minimi
     With minimize=False the plain Newton step is used, which can also converge to unstable
     equilibria (needed to follow the symmetric branch past a pitchfork); the line search then
     uses the energy where the Hessian is positive definite and the residual elsewhere. With
-    minimize=True an indefinite Hessian is shifted to be positive definite (modified Newton),
-    so the iteration descends to a stable equilibrium. The result counts the shortened steps
-    the line search tried (line_search_trials).
+    minimize=True the iteration descends in energy to a stable equilibrium by trust-region Newton
+    (ddg.solve.trust_region), which follows the negative curvature of an indefinite Hessian. The
+    result counts the shortened (or refused) steps tried (line_search_trials).
     """
     result, trials = _newton(model, q, options, minimize, evaluation)
     result.line_search_trials = trials
@@ -160,9 +160,24 @@ def _compiled(model, q, options, evaluation):
     return NewtonResult(q_end, ev, converged, int(iterations), float(res), bool(pd), message), int(trials)
 
 
+def _descent(model, q, options, evaluation):
+    """newton() for minimize=True: trust-region Newton (ddg.solve.trust_region)."""
+    max_iterations = options.max_iterations * MINIMIZE_ITERATION_FACTOR
+    residual_tol = max(options.residual_tol, model.residual_floor())
+    d = trust_region.minimize(model, q, options, max_iterations, ROUNDOFF_STALL_FACTOR * model.residual_floor(),
+                              evaluation)
+    converged = d.outcome in (compiled_newton.CONVERGED, compiled_newton.ROUNDOFF)
+    message = _message(d.outcome, options, d.residual, residual_tol, d.tiny_steps, 0.0, max_iterations)
+    return NewtonResult(d.q, d.evaluation, converged, d.iterations, d.residual, d.positive_definite, message), d.refused
+
+
 def _newton(model, q, options, minimize, evaluation):
+    """Plain Newton (minimize=False) in Python where the model has no compiled loop; the descent
+    (minimize=True) is _descent's."""
     options = options or NewtonOptions()
-    if options.compiled and not minimize and getattr(model, "compiled_energy", lambda: None)() is not None:
+    if minimize:
+        return _descent(model, q, options, evaluation)
+    if options.compiled and getattr(model, "compiled_energy", lambda: None)() is not None:
         return _compiled(model, q, options, evaluation)
     free = model.free
     rscale = model.residual_scale()[free]
@@ -171,13 +186,12 @@ def _newton(model, q, options, minimize, evaluation):
     q = q.copy()
     ev = evaluation if evaluation is not None else model.evaluate(q)
     pd = None
-    shift = 0.0
     tiny_steps, stall_residual = 0, np.inf
     trials = 0
-    fail_fast = options.give_up_after is not None and options.contraction_limit is not None and not minimize
+    fail_fast = options.give_up_after is not None and options.contraction_limit is not None
     noise = ROUNDOFF_STALL_FACTOR * model.residual_floor()
     previous_norm, previous_alpha, slow = None, 1.0, 0
-    max_iterations = options.max_iterations * (MINIMIZE_ITERATION_FACTOR if minimize else 1)
+    max_iterations = options.max_iterations
 
     def say(outcome, residual, tiny_steps=0, ratio=0.0):
         return _message(outcome, options, residual, residual_tol, tiny_steps, ratio, max_iterations)
@@ -190,15 +204,7 @@ def _newton(model, q, options, minimize, evaluation):
         pd = K.cholesky()
         if res < residual_tol:
             return NewtonResult(q, ev, True, iteration, res, pd), trials
-        if minimize and not pd:
-            # Levenberg-type modification: the smallest tried shift making K + mu I positive definite
-            shift = max(shift * 0.25, 1e-8 * K.mean_diagonal())
-            while not K.shifted(shift).cholesky():
-                shift *= 4.0
-            K = K.shifted(shift)
-            use_energy = True
-        else:
-            use_energy = pd
+        use_energy = pd
         dq = -K.solve(r)
         correction = float(np.max(np.abs(dq / lscale)))
         if correction < options.step_tol:
@@ -231,7 +237,7 @@ def _newton(model, q, options, minimize, evaluation):
         alpha = 1.0
         accepted = False
         # a load step whose Newton direction needs more than 1/1024 of a step is better halved
-        for trial in range(options.max_line_search if minimize else min(options.max_line_search, 10)):
+        for trial in range(min(options.max_line_search, 10)):
             q_try = q.copy()
             q_try[free] += alpha * dq
             # the full step is usually accepted: evaluate everything there; shorter trials need
@@ -259,10 +265,9 @@ def _newton(model, q, options, minimize, evaluation):
             return NewtonResult(q, ev, False, iteration + 1, res, pd, failed), trials
         if iteration == 0:
             first_residual = res
-        if not minimize:
-            if options.give_up_after is not None and iteration >= options.give_up_after \
-                    and res > options.give_up_ratio * first_residual:
-                return NewtonResult(q, ev, False, iteration + 1, res, pd, say(compiled_newton.NO_PROGRESS, res)), trials
+        if options.give_up_after is not None and iteration >= options.give_up_after \
+                and res > options.give_up_ratio * first_residual:
+            return NewtonResult(q, ev, False, iteration + 1, res, pd, say(compiled_newton.NO_PROGRESS, res)), trials
         model.commit(q_try, ev_try)
         q, ev = q_try, ev_try
         previous_alpha = alpha

@@ -161,7 +161,7 @@ def load_map(path) -> list[dict]:
 
 def fitting(rows) -> list[dict]:
     """The rows the prediction uses: all but those of held-out scenes (column role = "held-out":
-    scenes kept out of the fitting set to check the prediction, validation/error_map.py)."""
+    scenes kept out of the fitting set to check the prediction, validation/error_map/)."""
     return [r for r in rows if r.get("role") != "held-out"]
 
 

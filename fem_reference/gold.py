@@ -46,7 +46,7 @@ BASE_RESOLUTION = 64
 #: even (the mesh must be symmetric); h_y = W/8 .. W/24 (at 64 along L: 0.4 to 1.3 times h_x,
 #: at least 8 across, 4 of them on either side of y = 0).
 BASE_ACROSS = {1 / 20: 8, 1 / 12: 8, 1 / 10: 8, 1 / 8: 8, 1 / 6: 8, 1 / 4: 16, 1 / 3: 16, 1 / 2: 24}
-#: Scenes beyond the paper's ten that the error map (validation/error_map.py, issue 17) needs as
+#: Scenes beyond the paper's ten that the error map (validation/error_map/, issue 17) needs as
 #: references, as (dL/L, W/L, L/b or None for the paper's strip): held out of the map's fitting set
 #: to check its predictions (W/L = 1/8 and 1/4 lie between the paper's widths), and other L/b.
 #: Run with --only NAME; the default run is the paper's ten.
@@ -59,7 +59,7 @@ MAP_SCENES = ((1 / 2, 1 / 8, None), (1 / 4, 1 / 8, None), (1 / 2, 1 / 4, None), 
               (1 / 2, 1 / 20, 4000.0))
 #: Issue 32's fitting scenes for the map over dL/L and L/b: a third compression between the paper's
 #: two, and W/L = 1/6 at L/b = 4000 (the map has 1/6 at 300 and 1181 only; run with --only NAME
-#: like MAP_SCENES). The error map (validation/error_map.py) reads them as fitting scenes.
+#: like MAP_SCENES). The error map (validation/error_map/) reads them as fitting scenes.
 NEW_MAP_SCENES = ((1 / 3, 1 / 20, None), (1 / 3, 1 / 6, None), (1 / 3, 1 / 10, None), (1 / 3, 1 / 3, None),
                   (1 / 2, 1 / 6, 4000.0))
 #: Issue 32's held-out scenes, named with ddg.advise's rule v3 and committed before their
@@ -379,7 +379,7 @@ still draw it, while the claims and the benchmark use the studies' converged val
 part of its study (W/L = 1/6: 40 x 8, 60 x 12, 90 x 18, not asymptotic: convergence_40_60_90.md;
 the independent series of fem_reference/series.py, compared in series.md). Below the paper's ten, the error map's
 scenes (fem_reference.gold.MAP_SCENES, `--only NAME`, names with _Lb<L/b> for another strip) are
-listed as far as they have been run; the error map (validation/error_map.py) uses one from two meshes.
+listed as far as they have been run; the error map (validation/error_map/) uses one from two meshes.
 Issue 32's dL/L = 1/3 scenes (NEW_MAP_SCENES) are listed too; the map reads them once their plate
 studies exist.
 

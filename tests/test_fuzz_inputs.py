@@ -1,6 +1,6 @@
 """Issue 13, acceptance: no traceback on any input. A fuzz test of both command lines and the API.
 
-The contract, for every BAD input (tests/fuzz_cases.py generates them):
+The contract, for every BAD input (the package tests/fuzz_cases/ generates them):
 
 - command line (`python -m ddg ...` = ddg.cli.main, `python -m fem_reference ...` =
   fem_reference.cli.main): exit code 2 (returned, or SystemExit(2) from argparse), stderr exactly
@@ -39,7 +39,7 @@ incompatible options, unknown options and missing arguments; API calls), with id
 `ddg-simulate-rod-resolution-100000000` or `api-NewtonOptions-max_iterations-0`.
 
 Set DDG_FUZZ_RECORD=/path/file.jsonl to append one JSON record per case (id, outcome, cause,
-exit code, first stderr line, seconds); `python tests/fuzz_cases.py report /path/file.jsonl`
+exit code, first stderr line, seconds); `python tests/fuzz_cases/report.py /path/file.jsonl`
 lists the failing cases grouped by cause.
 """
 from __future__ import annotations

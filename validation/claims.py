@@ -2,7 +2,7 @@
 
 The report evaluates every claim on its own runs and prints the measured value, the bound and
 whether it holds (a claim whose runs or reference data are missing does not hold: "no data").
-tests/validation/test_validation.py asserts every claim with the same functions and bounds on runs it makes
+tests/validation/test_claims.py asserts every claim with the same functions and bounds on runs it makes
 itself (same scenes; where its plate is coarser than the report's, the test says so), so the report
 cannot state an agreement the test suite does not check; a claim that does not hold fails its test.
 

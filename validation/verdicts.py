@@ -2,7 +2,7 @@
 
 A verdict here holds its numbers and computes every word-deciding outcome from them (a level, a
 count, a list of exceptions); validation/templates/sentences.j2 only words these outcomes, so a
-sentence cannot conclude anything its numbers do not. tests/validation/test_validation.py tests each outcome
+sentence cannot conclude anything its numbers do not. tests/validation/test_verdicts.py tests each outcome
 on both sides of its boundaries.
 """
 from __future__ import annotations

@@ -507,13 +507,15 @@ def iterations_rows(runs: list[dict]) -> list[tuple]:
                      str(r["rejected_solves"]), str(r["failed_solves"]), str(r["fold_snaps"]),
                      _f(r["iterations_per_snap"], ".1f"), _f(r["threshold_iterations"], "d"),
                      str(r["thresholds_located"]), _f(r["iterations_per_threshold"], ".1f"),
-                     _f(r["branch_iterations"], "d"), str(r["whole_run_iterations"]), _f(r["wall_time_s"])))
+                     _f(r["branch_iterations"], "d"), str(r["whole_run_iterations"]), _f(r["wall_time_s"]),
+                     _f(r.get("cpu_time_s"))))
     return rows
 
 
 ITERATIONS_HEADER = ("model", "size", "W/L:dL/L", "status", "steps", "path its", "its/step", "accepted",
                      "rejected", "branch sw.", "compr. start", "fold snaps", "LS trials", "rej. solves", "failed",
-                     "snaps", "its/snap", "threshold its", "thr.", "its/thr.", "branch its", "whole", "wall s")
+                     "snaps", "its/snap", "threshold its", "thr.", "its/thr.", "branch its", "whole", "wall s",
+                     "cpu s")
 
 
 def physics_rows(runs: list[dict]) -> list[tuple]:
@@ -586,7 +588,8 @@ def markdown_report(report: dict) -> str:
     lines += [f"- {s}" for s in summary_sentences(results, targets)]
     lines += section("Targets (issue 49)") + targets_table(targets) + [
         "", "A per-step, rod or ribbon target is met only where every scene's path is complete and within the bound; "
-        "the fold-snap and threshold targets are the totals over the runs named (iterations / snaps or thresholds). "
+        "the fold-snap and threshold targets are the totals over the runs named (all fold-snap iterations / snaps; "
+        "all threshold-location iterations, those of runs that located none included, / thresholds located). "
         "\"Nothing physical changes\" is a before/after check: `--compare BEFORE AFTER`."]
     lines += section("Iterations per recorded step against the bound") + per_step_matrix(results)
     for title, models in FAMILIES:
@@ -611,7 +614,8 @@ def markdown_report(report: dict) -> str:
         "measured through public hooks only: the probe (ddg.solve.probe.Probe subclass on "
         "benchmarks.common.PathProbe) and summary.json",
         "load average (1 min) before each run: " + ", ".join(str(x) for x in loads if x is not None),
-    ] + [line.removeprefix("- ") for line in shared_machine_note(report)])
+    ] + ([f"the whole benchmark took {report['elapsed_s'] / 60:.1f} min"] if report.get("elapsed_s") else [])
+        + [line.removeprefix("- ") for line in shared_machine_note(report)])
     lines += machine_section(report)
     return "\n".join(lines) + "\n"
 

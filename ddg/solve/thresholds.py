@@ -8,8 +8,8 @@ the stability of the discrete equilibria instead of by eye.
   point-symmetric S state. Where US ends in a fold (a limit point in dW, where the strip snaps),
   that is the fold itself: pseudo-arclength from the last US state goes round it, the fold's dW
   is the vertex of the parabola through the three states about the turn (refined until they lie
-  within the tolerance), and an energy descent just past it confirms that the strip snaps to S
-  (locate_fold_snap). Otherwise, or if that check fails, bisection on the phase label of the
+  within the tolerance), and the recorded path's landing in S after the fold (or, without it, an
+  energy descent just past the fold) confirms that the strip snaps to S (locate_fold_snap). Otherwise, or if that check fails, bisection on the phase label of the
   state reached from the last US state (to 1e-3 L by default).
 - dW2_S_stable: where the S branch itself becomes stable, lambda_min of S (followed backwards
   without switching) changing sign; it differs from dW2 when US ends in a fold and snaps to S.
@@ -189,17 +189,20 @@ def _vertex(states, tracer, direction: float) -> float:
 
 
 def locate_fold_snap(model, options, start: Snapshot, first_after: float, is_after, tolerance: float,
-                     spent: list | None = None) -> float | None:
+                     spent: list | None = None, landed: State | None = None) -> float | None:
     """dW of the fold where the branch through `start` (stable up to there) ends, if it lies in
     (start.state.shear, first_after] and the strip snaps from it to a state with is_after(state);
     None otherwise (no fold in the bracket, an instability before it, or another snap).
 
     Pseudo-arclength goes from `start` towards first_after until dW turns back; the three states
     about the turn bracket the fold, refined (from the last state before them, with a quarter of
-    the step) until their dW lie within `tolerance`. Then Newton's energy descent from the state
-    nearest the fold, with the clamp moved to the fold's dW plus `tolerance`, must land on a
-    stable state that is_after accepts: the state the path follower reaches there (it would fail
-    into the fold and snap the same way), without its failed solves."""
+    the step) until their dW lie within `tolerance`. Then the snap must land on a stable state
+    that is_after accepts. `landed` is the state the recorded path reached at first_after, one
+    recorded load step after `start`: where is_after accepts it, the path's own snap (it failed
+    into this fold, the only end of the stable branch inside the bracket, and descended) is that
+    landing. Otherwise Newton's energy descent from the state nearest the fold, with the clamp
+    moved to the fold's dW plus `tolerance`, must reach one: the state the path follower would
+    reach there, without its failed solves."""
     L = model.strip.length
     direction = 1.0 if first_after >= start.state.shear else -1.0
     step = abs(first_after - start.state.shear) / L / 4.0
@@ -236,6 +239,8 @@ def locate_fold_snap(model, options, start: Snapshot, first_after: float, is_aft
             origin = replace(before, evaluation=model.evaluate(before.q))  # its Hessian was not kept
         else:
             return None
+        if landed is not None and landed.stable and is_after(landed):
+            return fold
         # the snap: energy descent from the stable state nearest the fold, just past it
         model.restore_frames(peak.frames if peak.stable else before.frames)
         seed = peak if peak.stable else before
@@ -245,8 +250,8 @@ def locate_fold_snap(model, options, start: Snapshot, first_after: float, is_aft
         used[0] += result.iterations
         if not (result.converged and result.positive_definite):
             return None
-        landed = State(result.q, result.evaluation, seed.compression, fold + direction * tolerance, True)
-        return fold if is_after(landed) else None
+        reached = State(result.q, result.evaluation, seed.compression, fold + direction * tolerance, True)
+        return fold if is_after(reached) else None
     finally:
         if spent is not None:
             spent[0] += used[0]
@@ -275,7 +280,8 @@ def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | 
             def in_s(state):
                 return phase_of(model, state).startswith("S")
 
-            out["dW2"] = locate_fold_snap(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L, spent)
+            out["dW2"] = locate_fold_snap(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L, spent,
+                                           landed=first_s.state)
             out["dW2_method"] = "fold"
             if out["dW2"] is None:
                 out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L,

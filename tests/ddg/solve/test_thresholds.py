@@ -195,7 +195,8 @@ def test_dW2_at_a_fold_is_the_fold_itself_and_lies_in_the_bisections_bracket(nar
     parabola's vertex on US against a sign change of lambda_min on S, bracket 1e-3; bound 1e-6, five
     times that; at M = 400 they differ by 2.3e-6, tests/ddg/solve/test_branches.py). Bisection on
     the phase (the fallback) lands within its 1e-3 bracket above it; the fold costs a fraction of
-    its iterations (measured 110 against 364 at M = 100)."""
+    its iterations (measured 58 at M = 100 since the path's landing confirms the snap, 110 with the
+    confirming descent, against 364)."""
     import ddg.solve.thresholds as thresholds
 
     fold = narrow_rod[100].summary
@@ -209,21 +210,26 @@ def test_dW2_at_a_fold_is_the_fold_itself_and_lies_in_the_bisections_bracket(nar
 
 
 def test_a_fold_that_does_not_snap_to_S_is_not_taken_for_dW2(monkeypatch):
-    """The descent just past the fold must land on S; with a criterion no state meets, the fold
-    locator declines (None) and the caller falls back to bisection."""
+    """The snap from the fold must land on S: the recorded path's landing where the caller gives
+    it, else the descent just past the fold. With a criterion no state meets, the fold locator
+    declines (None) and the caller falls back to bisection; the path's landing and the descent
+    confirm the same fold."""
     import ddg.solve.thresholds as thresholds
 
     real = thresholds.locate_fold_snap
     calls = []
 
-    def recording(*args):
-        calls.append(args)
-        return real(*args)
+    def recording(*args, **kwargs):
+        calls.append((args, kwargs))
+        return real(*args, **kwargs)
 
     monkeypatch.setattr(thresholds, "locate_fold_snap", recording)
     rod_path(0.5, 60)
-    (model, options, start, first_after, in_s, tolerance, _), = calls
-    assert real(model, options, start, first_after, in_s, tolerance) is not None
+    ((model, options, start, first_after, in_s, tolerance, _), kwargs), = calls
+    by_the_path = real(model, options, start, first_after, in_s, tolerance, landed=kwargs["landed"])
+    by_descent = real(model, options, start, first_after, in_s, tolerance)
+    assert by_the_path is not None and by_the_path == by_descent
+    assert real(model, options, start, first_after, lambda state: False, tolerance, landed=kwargs["landed"]) is None
     assert real(model, options, start, first_after, lambda state: False, tolerance) is None
 
 

@@ -9,8 +9,9 @@ the stability of the discrete equilibria instead of by eye.
   that is the fold itself: pseudo-arclength from the last US state goes round it, the fold's dW
   is the vertex of the parabola through the three states about the turn (refined until they lie
   within the tolerance), and the recorded path's landing in S after the fold (or, without it, an
-  energy descent just past the fold) confirms that the strip snaps to S (locate_fold_snap). Otherwise, or if that check fails, bisection on the phase label of the
-  state reached from the last US state (to 1e-3 L by default).
+  energy descent just past the fold) confirms that the strip snaps to S (locate_fold_snap).
+  Otherwise, or if that check fails, bisection on the phase label of the state reached from the
+  last US state (to 1e-3 L by default).
 - dW2_S_stable: where the S branch itself becomes stable, lambda_min of S (followed backwards
   without switching) changing sign; it differs from dW2 when US ends in a fold and snaps to S.
 

@@ -10,12 +10,17 @@ import numpy as np
 
 from ..geometry.frames import cross, rowdot
 from ..geometry.strip import LoadingProtocol, Strip
-from ..models.ribbon import RibbonModel
-from ..models.rod import RodModel
-from ..solve.continuation import ContinuationOptions, PathFollower, relax_from
+from ..api import simulate
+from ..models.names import RIBBON, ROD
+from ..solve.continuation import ContinuationFailure, ContinuationOptions
+from .curvature_studies import states_at_shears
 from ..solve.stability import lowest_modes
-from ..solve.state import Snapshot, State
+from ..solve.state import State
 from ..analysis.observables import observe
+
+
+#: Largest recorded load step of the paths (units of L): quasi-static, as the ribbon's U needs
+PATH_STEP = 0.025
 
 
 def same_state_in_frames(model, q_from: np.ndarray, frames_from, q: np.ndarray, frames) -> np.ndarray:
@@ -173,52 +178,40 @@ def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float
     - rod_lambda_min / ribbon_lambda_min at rod_dW1: normalised lowest eigenvalues of both
       models' U states there (the ribbon's U branch followed directly from the flat strip);
     - at dW = rod_dW1 + beyond: the ribbon's U state (direct) and its US state (relaxed from the
-      rod's US+), their energies, H_mid, and the straight-line barrier between them (and, with
+      rod's US), their energies, H_mid, and the straight-line barrier between them (and, with
       drag_samples > 0, the two-sided drag estimate of the barrier, a constrained minimisation
       per sample).
     """
     options = options or ContinuationOptions()
     L = strip.length
-    protocol = LoadingProtocol(compression_ratio, shear_ratio=None, compression_steps=20, shear_steps=40)
-    dL = compression_ratio * L
     unit = strip.bending_stiffness / L
-
-    def compressed(model):
-        follower = PathFollower(model, options)
-        state = follower.rest()
-        for k in range(1, protocol.compression_steps + 1):
-            target = dL * k / protocol.compression_steps
-            state = follower.start_compression(target) if k == 1 else follower.advance(state, target, 0.0)
-        return follower, state
-
-    rod, ribbon = RodModel(strip, resolution), RibbonModel(strip, resolution, zeta=zeta)
-    # the rod's pitchfork along its U branch
-    from ..solve.thresholds import locate_sign_change
-
-    rod_follow, rod_state = compressed(rod)
-    rod_follow.options = ContinuationOptions(**{**options.__dict__, "branch_switching": False})
     lam = lambda m, s: float(lowest_modes(m, s.evaluation.hessian, 1)[0])  # noqa: E731
-    step, last = 0.02 * L, Snapshot.take(rod, rod_state)
-    while lam(rod, rod_state) > 0 and rod_state.shear < 0.6 * L:
-        last = Snapshot.take(rod, rod_state)
-        rod_state = rod_follow.advance(rod_state, dL, rod_state.shear + step)
-    dw1 = locate_sign_change(rod, rod_follow.options, last, rod_state.shear, 1e-4 * L)
-    rod.restore_frames(last.frames)
-    rod_at = PathFollower(rod, rod_follow.options).advance(last.state, dL, dw1)
-    # the direct ribbon along its own path to the same shear
-    rib_follow, rib_state = compressed(ribbon)
-    for k in range(1, 11):
-        rib_state = rib_follow.advance(rib_state, dL, dw1 * k / 10)
+    # the rod's pitchfork: lambda_min = 0 on its U branch, located by the protocol's thresholds
+    rod_run = simulate(strip, LoadingProtocol(compression_ratio), model=ROD, resolution=resolution, options=options,
+                       branches=False)
+    if rod_run.summary.get("dW1_over_L") is None:
+        raise ContinuationFailure(f"the rod at W/L = {strip.width / L:g}, dL/L = {compression_ratio:g} has no "
+                                  "pitchfork on its path: nothing to compare the ribbon with")
+    dw1 = rod_run.summary["dW1_over_L"] * L
+    target = dw1 + beyond * L
+    shears = [dw1 / L, target / L]
+
+    def along(model_name, **kw):
+        """The (model, state, frames) at dW1 and beyond on the quasi-static path through the driver."""
+        return [(m, st, m.save_frames()) for m, st in states_at_shears(
+            model_name, strip, compression_ratio, shears, resolution, zeta=zeta, max_step=PATH_STEP,
+            options=options, **kw)]
+
+    (rod, rod_at, _), (_, rod_us, _) = along(ROD)
+    rod_lam = lam(rod, rod_at)
+    rod_height_beyond = float(rod.midpoint(rod_us.q)[2]) / L
+    # the direct ribbon along its own path: at dW1 and beyond (U, metastable) ...
+    (ribbon, rib_state, frames_at), (_, rib_u, frames_u) = along(RIBBON)
+    ribbon.restore_frames(frames_at)
     rib_lam = lam(ribbon, rib_state)
     rib_phase_at = observe(ribbon, rib_state, "shear")["phase"]
-    # beyond the pitchfork: ribbon U (direct) against ribbon US (from the rod's US+)
-    target = dw1 + beyond * L
-    rib_u = rib_follow.advance(rib_state, dL, target)
-    frames_u = ribbon.save_frames()
-    rod_switch = PathFollower(rod, options)
-    rod_us = rod_switch.advance(rod_at, dL, target)
-    rib_us = relax_from(ribbon, rod, rod_us, options)
-    frames_us = ribbon.save_frames()
+    # ... and the ribbon relaxed from the rod's US beyond dW1, in the direct ribbon's model
+    (_, _, _), (_, rib_us, frames_us) = along(RIBBON, ribbon_init=ROD)
     barrier = straight_line_barrier(ribbon, rib_u, frames_u, rib_us, frames_us)
     drag = drag_barrier(ribbon, rib_u, frames_u, rib_us, frames_us, drag_samples) if drag_samples else None
     ribbon.restore_frames(frames_u)
@@ -228,7 +221,7 @@ def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float
     top = barrier["top"]
     return {
         "rod_dW1_over_L": dw1 / L,
-        "rod_lambda_min_at_rod_dW1": lam(rod, rod_at),
+        "rod_lambda_min_at_rod_dW1": rod_lam,
         "ribbon_lambda_min_at_rod_dW1": rib_lam,
         "ribbon_phase_at_rod_dW1": rib_phase_at,
         "dW_over_L_beyond": target / L,
@@ -236,7 +229,7 @@ def pitchfork_analysis(strip: Strip, compression_ratio: float = 0.5, zeta: float
                      "energy": rib_u.evaluation.energy / unit},
         "ribbon_from_rod": {"phase": row_us["phase"], "H_mid_over_L": row_us["H_mid_over_L"],
                             "lambda_min": row_us["lambda_min"], "energy": rib_us.evaluation.energy / unit},
-        "rod_H_mid_over_L_beyond": float(rod.midpoint(rod_us.q)[2]) / L,
+        "rod_H_mid_over_L_beyond": rod_height_beyond,
         "straight_line_barrier": barrier["barrier"] / unit,
         "straight_line_barrier_quartic_share": (float(barrier["quartic"][top] / barrier["energy"][top])
                                                 if barrier["energy"][top] > 0 else float("nan")),

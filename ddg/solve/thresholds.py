@@ -11,7 +11,8 @@ the stability of the discrete equilibria instead of by eye.
   within the tolerance), and the recorded path's landing in S after the fold (or, without it, an
   energy descent just past the fold) confirms that the strip snaps to S (locate_fold_snap).
   Otherwise, or if that check fails, bisection on the phase label of the state reached from the
-  last US state (to 1e-3 L by default).
+  last US state (to 1e-3 L by default); where the pseudo-arclength pass reached S without a turn,
+  on stable states only, the bisection starts from the bracket of its last two states.
 - dW2_S_stable: where the S branch itself becomes stable, lambda_min of S (followed backwards
   without switching) changing sign; it differs from dW2 when US ends in a fold and snaps to S.
 
@@ -85,9 +86,11 @@ def locate_sign_change(model, options, start: Snapshot, other: float, tolerance:
         settled = _interpolated_root(samples, a, b, tolerance)
         if settled is not None:
             return settled
-        # The secant can land on the critical point itself, where the Hessian is singular and
-        # Newton may not converge: then try points between the guess and either end.
-        for trial in (guess, 0.5 * (guess + a), 0.5 * (guess + b), 0.75 * a + 0.25 * b, 0.25 * a + 0.75 * b):
+        # Where lambda_min is nearly linear the secant lands on the critical point itself, where the
+        # Hessian is singular and Newton converges slowly or not at all: the first trial goes halfway
+        # from the guess to the `a` end, a third sample that settles the interpolation; then the
+        # guess, then points between it and the `b` end.
+        for trial in (0.5 * (guess + a), guess, 0.5 * (guess + b), 0.75 * a + 0.25 * b, 0.25 * a + 0.75 * b):
             state = _advance(model, options, start, trial, switching=False, spent=spent)
             if state is not None:
                 guess = trial
@@ -190,7 +193,8 @@ def _vertex(states, tracer, direction: float) -> float:
 
 
 def locate_fold_snap(model, options, start: Snapshot, first_after: float, is_after, tolerance: float,
-                     spent: list | None = None, landed: State | None = None) -> float | None:
+                     spent: list | None = None, landed: State | None = None,
+                     narrowed: list | None = None) -> float | None:
     """dW of the fold where the branch through `start` (stable up to there) ends, if it lies in
     (start.state.shear, first_after] and the strip snaps from it to a state with is_after(state);
     None otherwise (no fold in the bracket, an instability before it, or another snap).
@@ -203,7 +207,11 @@ def locate_fold_snap(model, options, start: Snapshot, first_after: float, is_aft
     into this fold, the only end of the stable branch inside the bracket, and descended) is that
     landing. Otherwise Newton's energy descent from the state nearest the fold, with the clamp
     moved to the fold's dW plus `tolerance`, must reach one: the state the path follower would
-    reach there, without its failed solves."""
+    reach there, without its failed solves.
+
+    narrowed (a list, filled in place): where the branch reaches is_after without a turn, stable
+    throughout, [the Snapshot of its last state before, the first is_after state's dW]: the phase
+    change of the stable path lies between them (bisection may start there)."""
     L = model.strip.length
     direction = 1.0 if first_after >= start.state.shear else -1.0
     step = abs(first_after - start.state.shear) / L / 4.0
@@ -226,6 +234,13 @@ def locate_fold_snap(model, options, start: Snapshot, first_after: float, is_aft
             points, why = tracer.trace(origin, direction, stop=stop, keep_hessians=False)
             used[0] += tracer.newton_iterations
             if why != "stop condition" or len(points) < 1 or not (points[-1].shear * direction < seen[-2]):
+                if narrowed is not None and why == "stop condition" and is_after(points[-1]) \
+                        and all(p.stable for p in [origin] + points):
+                    # S reached without a fold, along a stable branch: the stable path itself
+                    last = points[-2] if len(points) >= 2 else origin
+                    model.restore_frames(last.frames if last is not origin else frames)
+                    narrowed[:] = [Snapshot(replace(last, evaluation=model.evaluate(last.q)), model.save_frames()),
+                                   points[-1].shear]
                 return None  # no turn within the bracket (or S reached without a fold)
             chain = [origin] + points
             before, peak, after = chain[-3:] if len(chain) >= 3 else (None, None, None)
@@ -281,12 +296,13 @@ def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | 
             def in_s(state):
                 return phase_of(model, state).startswith("S")
 
+            narrowed = []
             out["dW2"] = locate_fold_snap(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L, spent,
-                                           landed=first_s.state)
+                                           landed=first_s.state, narrowed=narrowed)
             out["dW2_method"] = "fold"
             if out["dW2"] is None:
-                out["dW2"] = locate_phase_change(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L,
-                                                   spent)
+                start, first_after = narrowed or (last_us, first_s.state.shear)
+                out["dW2"] = locate_phase_change(model, options, start, first_after, in_s, tolerances[1] * L, spent)
                 out["dW2_method"] = "bisection" if out["dW2"] is not None else None
             out["dW2_S_stable"] = locate_sign_change(model, options, first_s, last_us.state.shear, tolerances[1] * L,
                                                      spent)

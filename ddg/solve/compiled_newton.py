@@ -220,11 +220,13 @@ def _newton_load_step(args, q, state, energy0, parts0, grad0, band0, start, stop
                     theta, tiny_steps)
         dq = -solution[:, 0]
         correction = _max_scaled(dq, ls)
+        if correction < step_tol and res <= noise:  # converged to round-off (ddg.solve.newton.settled)
+            return (ROUNDOFF, q, e, parts, grad, band, state, iteration, res, pd, factor, accepted_count, trials,
+                    theta, tiny_steps + 1)
         if correction < step_tol:
             tiny_steps += 1
             if tiny_steps >= STALL_ITERATIONS and res > 0.5 * stall_residual:
-                outcome = ROUNDOFF if res <= noise else STALLED
-                return (outcome, q, e, parts, grad, band, state, iteration, res, pd, factor, accepted_count, trials,
+                return (STALLED, q, e, parts, grad, band, state, iteration, res, pd, factor, accepted_count, trials,
                         theta, tiny_steps)
             if tiny_steps == 1:
                 stall_residual = res

@@ -182,6 +182,9 @@ def minimize(model, q: np.ndarray, options, max_iterations: int, noise: float, e
         scaled = K.scaled(lengths)
         gs = g * lengths
         newton_step = (-K.solve(g) / lengths) if pd else None
+        if newton_step is not None and res <= noise and float(np.max(np.abs(newton_step))) < options.step_tol:
+            # a minimum fixed to within step_tol, its residual at round-off (ddg.solve.newton.settled)
+            return result(compiled_newton.ROUNDOFF, iteration, res)
         if newton_step is not None and -_model_value(scaled, gs, newton_step) <= ENERGY_NOISE * abs(ev.energy):
             # the energy cannot tell steps apart (near a minimum, or along a soft mode at round-off):
             # the Newton step, judged by the residual

@@ -8,6 +8,7 @@ import ddg
 from ddg.analysis.analytic import (EULER_ANTISYMMETRIC, EULER_SYMMETRIC, clamped_elastica_force,
                           clamped_elastica_midpoint_height)
 from ddg.models.rod import RodModel
+from ddg.solve.newton import NewtonOptions
 from ddg.solve.stability import lowest_modes
 
 
@@ -125,7 +126,9 @@ def test_narrow_strip_passes_U_to_US_near_036_and_US_to_S_near_052():
     # US -> S: the midpoint reaches the inflection (H_mid = 0) and stays there
     dW2 = dw[np.argmax(np.abs(h) < 1e-4 * 1.0)]
     assert abs(dW2 - 0.52) < 0.03
-    assert np.all(np.abs(h[dw > dW2 + 0.01]) < 1e-12)  # H = 0 on S by symmetry: measured 9e-15 (round-off)
+    # H = 0 on S by symmetry, to within Newton's step_tol (1e-10 L: a smaller correction at a residual
+    # at round-off ends the solve): measured 7e-12 (9e-15 while round-off convergence took 3 more steps)
+    assert np.all(np.abs(h[dw > dW2 + 0.01]) < NewtonOptions().step_tol)
     # before dW1 the midpoint barely drops; between the thresholds it falls to zero
     assert h[dw < 0.3].min() > 0.3 and h[(dw > dW1) & (dw < dW2)].max() < h[0]
 

@@ -155,7 +155,7 @@ def test_past_the_pitchfork_the_path_slides_onto_us_along_the_critical_mode():
     from ddg.api import make_model
     from ddg.solve.state import phase_label
     from ddg.solve.continuation import ContinuationOptions, PathFollower
-    from ddg.solve.newton import scaled_residual
+    from ddg.solve.newton import ROUNDOFF_STALL_FACTOR, NewtonOptions, scaled_residual
 
     strip = ddg.Strip.from_ratios(0.05, 0.5)
     L = strip.length
@@ -172,7 +172,10 @@ def test_past_the_pitchfork_the_path_slides_onto_us_along_the_critical_mode():
     spent = follower.iterations_by_phase["branch switching"] - before
     assert slid is not None and slid.stable and slid.branch_switched
     assert phase_label(model, slid.q, slid.compression, slid.shear) == "US+"
-    assert scaled_residual(model, slid.evaluation.gradient) < 1e-6
+    # converged as Newton judges it: the residual below tolerance or in the round-off band above the
+    # model's floor estimate (ddg.solve.newton.settled)
+    assert scaled_residual(model, slid.evaluation.gradient) <= max(NewtonOptions().residual_tol,
+                                                                   ROUNDOFF_STALL_FACTOR * model.residual_floor())
     # measured 80 here (M = 40, dW/L = 0.37); the energy descent it replaces took 345
     assert spent < 160, f"{spent} Newton iterations to leave the saddle"
 

@@ -79,8 +79,12 @@ def test_the_rods_path_with_the_test_has_the_same_thresholds_for_fewer_iteration
     assert on["newton_iterations"] < off["newton_iterations"]
     # threshold location does not use the test; it took 110 iterations both ways until the corrector
     # was compiled (issue 31 item 1), whose sums round differently at the fold: 110 against 109 since
-    # (bound restated after that measurement: within 2 %, as tests/ddg/solve/test_compiled_newton.py)
-    assert on["threshold_newton_iterations"] <= 1.02 * off["threshold_newton_iterations"]
+    # (bound restated after that measurement: within 2 %, as tests/ddg/solve/test_compiled_newton.py).
+    # Since round-off convergence is taken at the first tiny correction (issue 49) location takes
+    # 56 and 58 iterations: the two paths' states differ at round-off, and one iteration more or less
+    # in a bracketing solve is 2-4 % of so few; bound restated after that measurement: 2 % or 3.
+    assert on["threshold_newton_iterations"] <= max(1.02 * off["threshold_newton_iterations"],
+                                                    off["threshold_newton_iterations"] + 3)
 
 
 @pytest.mark.parametrize("value", [0.0, -0.5, 1.5, float("nan"), True, "x"])

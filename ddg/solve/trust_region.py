@@ -122,6 +122,33 @@ def trust_step(scaled, g: np.ndarray, radius: float, newton_step: np.ndarray | N
     return p, mu
 
 
+#: Longer multiples (2, 4, ..., 2^EXTENSIONS) of an accepted Newton step tried by their energy.
+EXTENSIONS = 3
+
+
+def _extend(model, q: np.ndarray, step: np.ndarray, accepted_energy: float, start_energy: float):
+    """A longer multiple of an accepted Newton step of a positive definite model, if the energy
+    falls further along it: (factor, q) or None.
+
+    Near a nearly singular minimum (a soft mode along which the energy is quartic, as where a
+    snap lands close to a pitchfork of the branch it lands on) the quadratic model holds only
+    within a short distance and each Newton step covers a fixed fraction of the way along the
+    soft mode (2/3 of it left per step where the energy is quartic): doubling the step while the
+    energy keeps falling covers it in a few energy evaluations."""
+    free = model.free
+    noise = ENERGY_NOISE * abs(start_energy)
+    best, best_factor, best_q = accepted_energy, 1.0, None
+    for k in range(1, EXTENSIONS + 1):
+        factor = 2.0 ** k
+        q_long = q.copy()
+        q_long[free] += factor * step
+        energy = model.evaluate(q_long, gradient=False, hessian=False).energy
+        if not (np.isfinite(energy) and energy < best - noise):
+            break
+        best, best_factor, best_q = energy, factor, q_long
+    return None if best_q is None else (best_factor, best_q)
+
+
 class Descent(NamedTuple):
     """How a descent ended: outcome (ddg.solve.compiled_newton's codes), the last iterate and its
     evaluation, the steps taken (each ending in an evaluation with gradient and Hessian), the
@@ -221,10 +248,20 @@ def minimize(model, q: np.ndarray, options, max_iterations: int, noise: float, e
             if res <= noise:
                 return result(compiled_newton.ROUNDOFF, iteration, res)
             return result(compiled_newton.LINE_SEARCH_FAILED, iteration, res)
+        if shift == 0.0 and newton_step is not None:
+            extended = _extend(model, q, step, trial.energy, ev.energy)
+            if extended is not None:
+                factor, q_try = extended
+                refused += EXTENSIONS  # energy evaluations, counted with the refused steps
+                p_scaled = factor * p_scaled
+                correction *= factor
+                predicted = -np.inf  # the ball grows below: the model was too timid
         size = float(np.linalg.norm(p_scaled))
-        rho = actual / predicted if predicted < 0.0 else 1.0
+        rho = actual / predicted if predicted < 0.0 and np.isfinite(predicted) else 1.0
         flat = -predicted <= FLAT * ENERGY_NOISE * abs(ev.energy)
-        if flat or (rho >= GROW and size >= (1.0 - SECULAR_TOLERANCE) * radius):
+        if not np.isfinite(predicted):
+            radius = min(max(radius, size), MAX_RADIUS * math.sqrt(n))
+        elif flat or (rho >= GROW and size >= (1.0 - SECULAR_TOLERANCE) * radius):
             # a good model, or one the energy's round-off cannot check (a flat stretch, the ghost of
             # a fold just passed, where only longer steps get anywhere): a larger ball
             radius = min(2.0 * radius, MAX_RADIUS * math.sqrt(n))

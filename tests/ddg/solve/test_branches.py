@@ -120,7 +120,7 @@ def test_S_branch_is_unstable_before_and_stable_after_dW2_S_stable(rod):
 def test_narrow_plate_US_branch_folds_and_the_path_snaps_to_S(narrow_plate):
     """The plate's US branch ends in a fold (a limit point in dW), not at the S pitchfork: past it
     the branch turns back unstable and meets S at a smaller dW. The recorded path goes round the
-    fold by pseudo-arclength and snaps to S there; dW2 (the stable path reaches S, to 1e-3 L) is the
+    fold and snaps to S there; dW2 (the stable path reaches S, to 1e-3 L) is the
     fold, and S turns stable just before it (measured 0.4517, 0.4519, 0.4511 at 600 triangles).
     (A second, tiny fold pair at dW/L = 0.3745-0.3747 is a short unstable stretch inside US.)"""
     s = narrow_plate.summary
@@ -131,7 +131,13 @@ def test_narrow_plate_US_branch_folds_and_the_path_snaps_to_S(narrow_plate):
     assert s["dW2_S_stable_over_L"] < fold
     dw, lam = branch(narrow_plate, "US+", "dW_over_L"), branch(narrow_plate, "US+", "lambda_min")
     top = int(np.argmax(dw))
-    assert dw[top] == pytest.approx(fold, abs=2e-4)
+    # the path's record of the fold is the last state before its snap where the snap is an energy
+    # descent (ddg.solve.continuation.PathFollower.folds), the fold itself where pseudo-arclength went
+    # round it: within a hard substep (jump_substep of a recorded interval) below the branch's fold.
+    # Restated when the descent began to land here (issue 49): the path's fold 0.45125, the branch's
+    # 0.45157, the substep 6e-4 L; it was 2e-4 while the descent failed and the arclength pass found it
+    interval = 0.47 / 47
+    assert 0.0 <= dw[top] - fold <= ddg.ContinuationOptions().jump_substep * interval + 1e-9
     beyond = slice(top + 1, None)
     bottom = top + 1 + int(np.argmin(dw[beyond]))
     assert bottom - top >= 3 and np.all(np.diff(dw[top:bottom + 1]) < 0)  # going back in dW ...

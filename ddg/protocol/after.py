@@ -10,7 +10,7 @@ import time
 
 from ..analysis.observables import observe, unresolved_reason
 from ..solve.branches import trace_branches
-from ..solve.state import Snapshot
+from ..solve.state import Snapshot, phase_of
 from ..solve.thresholds import shear_thresholds
 
 THRESHOLD_KEYS = ("dW1_over_L", "dW2_over_L", "dW2_S_stable_over_L")
@@ -27,6 +27,9 @@ class Brackets:
         self.first_us: float | None = None
         self.last_us: Snapshot | None = None
         self.first_s: Snapshot | None = None
+        #: the last US state before the snap into S, where the path snapped past a fold: within a
+        #: hard substep of the fold, where the fold's location starts (ddg.solve.thresholds)
+        self.near_fold: Snapshot | None = None
 
     def __call__(self, stage: str, state, row: dict) -> None:
         if stage == "shear":
@@ -43,6 +46,14 @@ class Brackets:
                 self.last_us = Snapshot.take(model, state)
         elif phase.startswith("S") and self.first_s is None and self.last_us is not None:
             self.first_s = Snapshot.take(model, state)
+            before = getattr(state, "snapped_from", None)
+            if before is not None and phase_of(model, before.state).startswith("US") and \
+                    _between(before.state.shear, self.last_us.state.shear, state.shear):
+                self.near_fold = before
+
+
+def _between(x: float, a: float, b: float) -> bool:
+    return min(a, b) < x < max(a, b)
 
 
 def locate_thresholds(summary: dict, model, options, brackets: Brackets) -> None:
@@ -50,7 +61,8 @@ def locate_thresholds(summary: dict, model, options, brackets: Brackets) -> None
     summary keys THRESHOLD_KEYS, dW2_located_by ("fold", "bisection" or None: ddg.solve.thresholds),
     threshold_wall_time_s, threshold_newton_iterations."""
     t0 = time.perf_counter()
-    found = shear_thresholds(model, options, brackets.last_u, brackets.first_us, brackets.last_us, brackets.first_s)
+    found = shear_thresholds(model, options, brackets.last_u, brackets.first_us, brackets.last_us, brackets.first_s,
+                             near_fold=brackets.near_fold)
     L = model.strip.length
     for key, name in zip(("dW1", "dW2", "dW2_S_stable"), THRESHOLD_KEYS):
         summary[name] = None if found[key] is None else abs(found[key]) / L

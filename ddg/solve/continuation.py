@@ -21,7 +21,7 @@ from .extrapolation import LOAD_PREDICTOR_POINTS, extrapolate
 from .probe import SILENT, Probe
 from .newton import NewtonOptions, check_option, newton, settled
 from .stability import lowest_modes
-from .state import State, asymmetry, crosses, phase_of
+from .state import Snapshot, State, asymmetry, crosses, phase_of
 
 
 #: The largest push off an unstable state (relative to L) tried before giving up on it.
@@ -185,12 +185,15 @@ class PathFollower:
         t = 0.0
         iterations = 0
         switched = False
+        snapped_from = None
         while t < 1.0:
             t_next = min(1.0, t + self.substep)
             load = start + t_next * (target - start)
             # near singular points (thresholds) Newton converges only linearly: allow it more iterations
             hard = self.substep <= self.options.jump_substep
             new = self._step(state, *load, patient=hard)
+            before = Snapshot.take(self.model, state) if new is None and hard else None
+            folds = len(self.folds)
             if new is None and hard and self.options.branch_switching:
                 # the branch has ended (a fold): let the strip snap to the nearest stable state
                 new = self._jump(state, *load)
@@ -202,6 +205,8 @@ class PathFollower:
                 # converge): pseudo-arclength goes round the fold and, with switching, follows the
                 # unstable part to the branch the strip snaps to; or past a hard spot to the target
                 new = self._across_fold(state, *load)
+            if new is not None and len(self.folds) > folds:
+                snapped_from = before
             if new is None:
                 self._easy_streak = 0
                 self.substep *= 0.5
@@ -241,6 +246,8 @@ class PathFollower:
             state, t = new, t_next
         state.iterations = iterations
         state.branch_switched = switched
+        if snapped_from is not None:
+            state.snapped_from = snapped_from
         return state
 
     @property

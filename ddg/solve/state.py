@@ -32,6 +32,9 @@ class State:
     iterations: int = 0
     branch_switched: bool = False
     frames: object = None  # the model's reference frames at this state (rod), where kept
+    #: where the path reached this state by a snap past a fold (PathFollower.advance): the Snapshot
+    #: of the last state before it, on the branch that folds, within a hard substep of the fold
+    snapped_from: object = None
 
 
 @dataclass

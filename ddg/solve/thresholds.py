@@ -280,10 +280,13 @@ THRESHOLD_TOLERANCES = (1e-4, 1e-3)
 
 def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | None,
                      last_us: Snapshot | None, first_s: Snapshot | None,
-                     tolerances: tuple[float, float] = THRESHOLD_TOLERANCES) -> dict:
+                     tolerances: tuple[float, float] = THRESHOLD_TOLERANCES, near_fold: Snapshot | None = None) -> dict:
     """dW1, dW2 and dW2_S_stable (in metres; None where not bracketed by the recorded path),
     "dW2_method" ("fold": the vertex of the fold US ends in, located by pseudo-arclength;
-    "bisection": on the phase reached; None) and "newton_iterations": those spent locating them."""
+    "bisection": on the phase reached; None) and "newton_iterations": those spent locating them.
+    near_fold: the path's last US state before its snap into S (State.snapped_from), between last_us
+    and first_s: the fold's location starts there, a hard substep from the fold, instead of a
+    recorded load step."""
 
     L = model.strip.length
     saved = model.save_frames()
@@ -297,8 +300,8 @@ def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | 
                 return phase_of(model, state).startswith("S")
 
             narrowed = []
-            out["dW2"] = locate_fold_snap(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L, spent,
-                                           landed=first_s.state, narrowed=narrowed)
+            out["dW2"] = locate_fold_snap(model, options, near_fold or last_us, first_s.state.shear, in_s,
+                                           tolerances[1] * L, spent, landed=first_s.state, narrowed=narrowed)
             out["dW2_method"] = "fold"
             if out["dW2"] is None:
                 start, first_after = narrowed or (last_us, first_s.state.shear)

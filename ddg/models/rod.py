@@ -117,6 +117,30 @@ class RodModel(BandedModel):
         i = np.arange(self.nodes)
         return i, i[::-1]
 
+    def half_turn(self, q: np.ndarray, frames, compression: float, shear: float):
+        """The state the scene's half turn makes of (q, frames) at the clamp displacement
+        (compression, shear): (q', frames'), or None where the model has edge fields (their parity
+        under the turn is not defined here).
+
+        The turn is R = diag(-1, -1, 1) about the vertical axis through the midpoint c between the
+        clamp points; node i goes to node M - 1 - i, x' = R (x - c) + c, and edge j to edge M - 2 - j
+        with the tangent reversed, t' = -R t. The material frame turns with the body, m1' = R m1,
+        and m2' = -R m2 keeps it right-handed about t'; with the reference director turned the same
+        way, d1' = R d1, the twist angle changes sign, theta' = -theta, and the reference twist
+        between two edges is kept, in reverse order. The clamps map onto each other and their
+        angles (zero) onto zero. An equilibrium maps onto an equilibrium (the callers check its
+        residual)."""
+        if self.edge_fields:
+            return None
+        turn = np.array([-1.0, -1.0, 1.0])
+        c = np.array([0.5 * (self.strip.length - compression), 0.5 * shear, 0.0])
+        out = np.empty_like(q)
+        x = q[self.node_dofs]
+        out[self.node_dofs] = (turn * (x - c) + c)[::-1]
+        out[self.theta_dofs] = -q[self.theta_dofs][::-1]
+        tangents, d1, ref_twist = frames
+        return out, (-(turn * tangents)[::-1], (turn * d1)[::-1], ref_twist[::-1].copy())
+
     def resolution_indicators(self, q: np.ndarray) -> dict:
         """Largest turning angle between neighbouring edges (degrees) and largest edge strain."""
         x = q[self.node_dofs]

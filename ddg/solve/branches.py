@@ -9,7 +9,9 @@ pseudo-arclength continuation in dW (ddg.solve.arclength), so folds are passed, 
   the critical mode at fixed dW (Keller's branch switching: no imperfection, no energy descent);
   each branch is then traced until it reaches the point-symmetric S branch (the shape is S) or
   dW_max. Where US folds (the narrow plate), the tracer goes round the fold and follows the
-  unstable part back to S.
+  unstable part back to S. Where the model maps a state onto its half turn (the rod layout without
+  edge fields: model.half_turn), US- is US+ turned, each image checked an equilibrium of the same
+  stability and the mirror phase, and traced only where a check fails.
 - S+ (S- with branch_sign = -1): from the first S state of the recorded path, backwards as far as
   the branch goes and forwards to dW_max.
 
@@ -24,6 +26,7 @@ import numpy as np
 
 from .arclength import ArclengthOptions, ArclengthTracer
 from .continuation import ContinuationOptions
+from .newton import ROUNDOFF_STALL_FACTOR, scaled_residual
 from .stability import lowest_modes
 from .state import Snapshot, State, crosses, phase_of
 
@@ -37,6 +40,8 @@ class Branch:
     name: str
     states: list[State] = field(default_factory=list)
     end: str = ""
+    #: how its states were found: "pseudo-arclength", or "half turn of US+" (each image checked)
+    source: str = "pseudo-arclength"
 
     def folds(self) -> list[float]:
         """dW (m) at the limit points: where the branch turns back in dW."""
@@ -54,7 +59,8 @@ class BifurcationDiagram:
     newton_iterations: int
 
     def summary(self, length: float) -> dict:
-        """Per branch: points, dW/L range, folds (dW/L), how it ended; for summary.json."""
+        """Per branch: points, dW/L range, folds (dW/L), how it ended and how it was found
+        (source); for summary.json."""
         out = {}
         for b in self.branches:
             shear = [s.shear / length for s in b.states]
@@ -62,8 +68,41 @@ class BifurcationDiagram:
                            "dW_over_L_range": [min(shear), max(shear)] if shear else None,
                            "folds_dW_over_L": [f / length for f in b.folds()],
                            "stable_points": int(sum(bool(s.stable) for s in b.states)),
-                           "end": b.end}
+                           "end": b.end,
+                           "source": b.source}
         return out
+
+
+def half_turn_branch(model, options: ContinuationOptions, branch: Branch) -> list[State] | None:
+    """The half turn's image of every state of `branch` (model.half_turn: US+ onto US-), each
+    evaluated and checked an equilibrium: its scaled residual within Newton's converged band
+    (residual_tol, or ROUNDOFF_STALL_FACTOR times the model's floor estimate) and its phase the
+    mirror of the original's. None where the model has no such map, a state kept no frames, or a
+    check fails (the caller then traces the branch)."""
+    turn = getattr(model, "half_turn", None)
+    if turn is None or not branch.states:
+        return None
+    band = max(options.newton.residual_tol, ROUNDOFF_STALL_FACTOR * model.residual_floor())
+    saved = model.save_frames()
+    images = []
+    try:
+        for state in branch.states:
+            mapped = turn(state.q, state.frames, state.compression, state.shear) if state.frames is not None else None
+            if mapped is None:
+                return None
+            q, frames = mapped
+            model.restore_frames(frames)
+            ev = model.evaluate(q)
+            image = State(q, ev, state.compression, state.shear, bool(model.free_matrix(ev.hessian).cholesky()),
+                          frames=frames)
+            mirror = {"US+": "US-", "US-": "US+"}.get(phase_of(model, state), phase_of(model, state))
+            if scaled_residual(model, ev.gradient) > band or image.stable != state.stable or \
+                    phase_of(model, image) != mirror:
+                return None
+            images.append(image)
+    finally:
+        model.restore_frames(saved)
+    return images
 
 
 def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, shear_max: float,
@@ -107,6 +146,11 @@ def trace_branches(model, options: ContinuationOptions, compressed: Snapshot, sh
         along = tracer.inner(phi, 0.0, u_q, u_w)
         critical = (phi - along * u_q, -along * u_w)
         for sign, name in ((1.0, "US+"), (-1.0, "US-")):
+            if name == "US-" and branches[-1].name == "US+":
+                mirrored = half_turn_branch(model, options, branches[-1])
+                if mirrored is not None:
+                    finish(Branch(name, end=branches[-1].end, source="half turn of US+"), mirrored)
+                    continue
             model.restore_frames(near.frames)
             tangent = tracer.normalise(sign * critical[0], sign * critical[1])
             # the US branches join S at the S branch's own pitchfork, and the tracer would go

@@ -88,6 +88,8 @@ def test_US_branches_run_from_the_pitchfork_to_the_S_branch(rod):
         assert dw[-1] == pytest.approx(s["dW2_S_stable_over_L"], abs=1e-3)
         assert abs(h[-1]) < 5e-3
         assert s["branches"][name]["end"] == "stop condition"
+    # the rod maps a state onto its half turn: US- is US+ turned, every image checked
+    assert [s["branches"][name]["source"] for name in ("US+", "US-")] == ["pseudo-arclength", "half turn of US+"]
 
 
 def test_US_plus_and_US_minus_are_mirror_images(rod):

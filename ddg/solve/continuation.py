@@ -77,13 +77,6 @@ class ContinuationOptions:
                              f"S-)")
 
 
-#: Branch switching at a pitchfork of the shear by pseudo-arclength (_switch_by_arclength): the
-#: first step along the critical mode (as ddg.solve.branches.PITCHFORK_STEP) and the most states
-#: traced from there to the load.
-SWITCH_STEP = 2e-3
-SWITCH_POINTS = 40
-
-
 #: Largest number of states traced along the unstable part of a folded branch (_snap_past_fold).
 #: The paper's plate at L/b = 4000, W/L = 1/20 (2100 triangles) goes from the fold of US at dW/L =
 #: 0.3848 back to a second fold at 0.3586 and on, stable again, to 0.3848 in about 100 (measured).
@@ -457,10 +450,6 @@ class PathFollower:
         sign = 1.0 if model.mode_sign(mode, direction) >= 0 else -1.0
         if direction == 0:
             sign *= self.options.branch_sign
-        if direction == 0:
-            switched = self._switch_by_arclength(state, sign * mode)
-            if switched is not None:
-                return switched
         slid = self._slide_along_mode(state, sign * mode)
         if slid is not None:
             return slid
@@ -480,50 +469,6 @@ class PathFollower:
                              state.iterations + result.iterations, branch_switched=True)
             model.restore_frames(saved)
         return None
-
-    def _switch_by_arclength(self, unstable: State, mode: np.ndarray) -> State | None:
-        """From an unstable state on the symmetric branch just past a pitchfork of the shear, the
-        stable asymmetric state at its load by Keller's branch switching, as branch tracing starts
-        US (ddg.solve.branches): a pseudo-arclength step of SWITCH_STEP along the critical mode at
-        fixed dW lands on the asymmetric branch at its own dW, the branch is traced to the state's
-        dW, and Newton at that load starts from the cubic in dW through the last states. None
-        if a step fails, the branch does not reach the load in SWITCH_POINTS states, or the state
-        there is not stable."""
-        model = self.model
-        saved = model.save_frames()
-        target = unstable.shear
-        tracer = ArclengthTracer(model, self.options.newton)
-        # the mode made orthogonal to the symmetric branch's own tangent, whose states at other dW
-        # differ from this one by a field with a component along the mode (ddg.solve.branches)
-        u_q, u_w = tracer.tangent(unstable)
-        phi = mode[model.free]
-        along = tracer.inner(phi, 0.0, u_q, u_w)
-        first, _ = tracer.trace(unstable, tangent=tracer.normalise(phi - along * u_q, -along * u_w), max_points=1,
-                                initial_step=SWITCH_STEP)
-        points = []
-        if first:
-            landed = first[0]
-            direction = 1.0 if target >= landed.shear else -1.0
-            points, _ = tracer.trace(landed, direction, max_points=SWITCH_POINTS, keep_hessians=False,
-                                     stop=lambda s: (s.shear - target) * direction >= 0)
-            points = [landed] + points
-        self._spent(tracer.newton_iterations, "branch switching")
-        if len(points) < 2 or (points[-1].shear - target) * direction < 0:
-            model.restore_frames(saved)
-            return None
-        # the branch through its last states (dW monotonic there) interpolated at the load: a cubic
-        # in dW, the chord between two states some way apart on the curved branch being too far off
-        near = points[-LOAD_PREDICTOR_POINTS:]
-        model.restore_frames(near[-2].frames)
-        q = extrapolate([p.shear for p in near], [p.q for p in near], target)
-        q[model.constrained] = model.clamp_values(unstable.compression, target)
-        result = newton(model, q, replace(self.options.newton, contraction_limit=None, give_up_after=None))
-        self._spent(result.iterations, "branch switching", result.converged)
-        if not (result.converged and result.positive_definite):
-            model.restore_frames(saved)
-            return None
-        return State(result.q, result.evaluation, unstable.compression, target, True,
-                     unstable.iterations + result.iterations, branch_switched=True)
 
     def _constrained_equilibrium(self, q: np.ndarray, origin: np.ndarray, direction: np.ndarray, amplitude: float):
         """Equilibrium with the amplitude along `direction` (free DOFs) held: grad_f E + mu w = 0,

@@ -302,6 +302,12 @@ def shear_thresholds(model, options, last_u: Snapshot | None, first_us: float | 
             narrowed = []
             out["dW2"] = locate_fold_snap(model, options, near_fold or last_us, first_s.state.shear, in_s,
                                            tolerances[1] * L, spent, landed=first_s.state, narrowed=narrowed)
+            if out["dW2"] is None and near_fold is not None:
+                # the state before the snap need not sit below a fold of its own branch (a substep
+                # that failed short of a snap elsewhere): from the recorded US state, as without it
+                narrowed = []
+                out["dW2"] = locate_fold_snap(model, options, last_us, first_s.state.shear, in_s, tolerances[1] * L,
+                                               spent, landed=first_s.state, narrowed=narrowed)
             out["dW2_method"] = "fold"
             if out["dW2"] is None:
                 start, first_after = narrowed or (last_us, first_s.state.shear)

@@ -210,8 +210,7 @@ def _newton(model, q, options, minimize, evaluation):
         correction = float(np.max(np.abs(dq / lscale)))
         if correction < options.step_tol and res <= noise:
             # fixed to within step_tol, the residual in the round-off band: converged (settled()); it
-            # need not be seen to stall for STALL_ITERATIONS more (measured on the rod, W/L = 1/6: the
-            # residual at the first such correction is 1.0-45 times the floor estimate, median 2.3)
+            # need not be seen to stall for STALL_ITERATIONS more (docs/findings/measured.md)
             return NewtonResult(q, ev, True, iteration, res, pd, say(compiled_newton.ROUNDOFF, res)), trials
         if correction < options.step_tol:
             # The correction is below tolerance but the residual is not: in a stiff (stretching)

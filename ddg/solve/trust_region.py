@@ -127,8 +127,8 @@ EXTENSIONS = 3
 
 
 def _extend(model, q: np.ndarray, step: np.ndarray, accepted_energy: float, start_energy: float):
-    """A longer multiple of an accepted Newton step of a positive definite model, if the energy
-    falls further along it: (factor, q) or None.
+    """The longest multiple of an accepted Newton step of a positive definite model along which the
+    energy keeps falling: (factor, q or None where no longer step is lower, energy evaluations made).
 
     Near a nearly singular minimum (a soft mode along which the energy is quartic, as where a
     snap lands close to a pitchfork of the branch it lands on) the quadratic model holds only
@@ -138,15 +138,17 @@ def _extend(model, q: np.ndarray, step: np.ndarray, accepted_energy: float, star
     free = model.free
     noise = ENERGY_NOISE * abs(start_energy)
     best, best_factor, best_q = accepted_energy, 1.0, None
+    evaluations = 0
     for k in range(1, EXTENSIONS + 1):
         factor = 2.0 ** k
         q_long = q.copy()
         q_long[free] += factor * step
         energy = model.evaluate(q_long, gradient=False, hessian=False).energy
+        evaluations += 1
         if not (np.isfinite(energy) and energy < best - noise):
             break
         best, best_factor, best_q = energy, factor, q_long
-    return None if best_q is None else (best_factor, best_q)
+    return best_factor, best_q, evaluations
 
 
 class Descent(NamedTuple):
@@ -248,18 +250,18 @@ def minimize(model, q: np.ndarray, options, max_iterations: int, noise: float, e
             if res <= noise:
                 return result(compiled_newton.ROUNDOFF, iteration, res)
             return result(compiled_newton.LINE_SEARCH_FAILED, iteration, res)
+        extended = False
         if shift == 0.0 and newton_step is not None:
-            extended = _extend(model, q, step, trial.energy, ev.energy)
-            if extended is not None:
-                factor, q_try = extended
-                refused += EXTENSIONS  # energy evaluations, counted with the refused steps
+            factor, longer, evaluations = _extend(model, q, step, trial.energy, ev.energy)
+            refused += evaluations  # energy evaluations, counted with the refused steps
+            if longer is not None:
+                extended, q_try = True, longer
                 p_scaled = factor * p_scaled
                 correction *= factor
-                predicted = -np.inf  # the ball grows below: the model was too timid
         size = float(np.linalg.norm(p_scaled))
-        rho = actual / predicted if predicted < 0.0 and np.isfinite(predicted) else 1.0
+        rho = actual / predicted if predicted < 0.0 else 1.0
         flat = -predicted <= FLAT * ENERGY_NOISE * abs(ev.energy)
-        if not np.isfinite(predicted):
+        if extended:  # the model was too timid: the ball takes the step that was taken
             radius = min(max(radius, size), MAX_RADIUS * math.sqrt(n))
         elif flat or (rho >= GROW and size >= (1.0 - SECULAR_TOLERANCE) * radius):
             # a good model, or one the energy's round-off cannot check (a flat stretch, the ghost of

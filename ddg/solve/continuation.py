@@ -77,6 +77,11 @@ class ContinuationOptions:
                              f"S-)")
 
 
+#: Solved points of the constrained branch (amplitude along the mode held) through which the
+#: slide off a saddle extrapolates its next point (_slide_along_mode): a quadratic, as the branch
+#: bends with the square of the amplitude past a pitchfork.
+SLIDE_PREDICTOR_POINTS = 3
+
 #: Largest number of states traced along the unstable part of a folded branch (_snap_past_fold).
 #: The paper's plate at L/b = 4000, W/L = 1/20 (2100 triangles) goes from the fold of US at dW/L =
 #: 0.3848 back to a second fold at 0.3586 and on, stable again, to 0.3848 in about 100 (measured).
@@ -541,9 +546,9 @@ class PathFollower:
             if a > 0.5:
                 model.restore_frames(saved)
                 return None
-            if len(points) >= 2:  # linear extrapolation in a of the constrained branch
-                a1, q1 = points[-2][0], points[-2][1]
-                predicted = q0 + (q0 - q1) * (a - a0) / (a0 - a1)
+            if len(points) >= 2:  # polynomial extrapolation in a of the constrained branch
+                near = points[-SLIDE_PREDICTOR_POINTS:]
+                predicted = extrapolate([p[0] for p in near], [p[1] for p in near], a)
             else:
                 predicted = q0 + (a - a0) * L * mode
             model.restore_frames(frames0)
@@ -554,9 +559,10 @@ class PathFollower:
                     model.restore_frames(saved)
                     return None
         # the root of mu(a) lies between the last two amplitudes: secant steps on the constrained
-        # branch, each predicted by extrapolation from the two solved points nearest below it (a
-        # chord between the bracket's ends is too far off the curved branch); Newton from a point
-        # whose multiplier is small lands on the equilibrium
+        # branch, each predicted by the quadratic through the three solved points nearest to it (a
+        # chord between the bracket's ends, or a line through two points below, is too far off the
+        # curved branch for the constrained Newton); Newton from a point whose multiplier is small
+        # lands on the equilibrium
         lo, hi = points[-2], points[-1]
         below = points[-3] if len(points) >= 3 else None
         side = 0
@@ -570,8 +576,10 @@ class PathFollower:
                     return State(result.q, result.evaluation, unstable.compression, unstable.shear, True,
                                  unstable.iterations + result.iterations, branch_switched=True)
             a = lo[0] + lo[2] / (lo[2] - hi[2]) * (hi[0] - lo[0])
-            if below is not None:
-                predicted = lo[1] + (lo[1] - below[1]) * (a - lo[0]) / (lo[0] - below[0])
+            if below is not None:  # the quadratic through the solved points nearest to a
+                near = sorted({p[0]: p for p in points}.values(), key=lambda p: abs(p[0] - a))
+                near = near[:SLIDE_PREDICTOR_POINTS]
+                predicted = extrapolate([p[0] for p in near], [p[1] for p in near], a)
             else:
                 predicted = lo[1] + (a - lo[0]) * L * mode
             model.restore_frames(lo[3])

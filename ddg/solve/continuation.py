@@ -98,6 +98,9 @@ class PathFollower:
         self._easy_streak = 0
         self._history: list[tuple[np.ndarray, np.ndarray]] = []  # (load, q) of the last equilibria on this branch
         self._fold_tried_at = None
+        #: the last state from which a snap's energy descent did not converge (_jump): not tried again
+        #: from it at shorter substeps, where the descent starts from the same shape
+        self._descent_failed_from = None
         self.folds: list[float] = []  # dW (m) of the limit points met (pseudo-arclength turned back there)
         #: Newton iterations per phase of the path (PHASES), the public record of where they go
         self.iterations_by_phase: dict[str, int] = dict.fromkeys(PHASES, 0)
@@ -199,7 +202,7 @@ class PathFollower:
             new = self._step(state, *load, patient=hard)
             before = Snapshot.take(self.model, state) if new is None and hard else None
             folds = len(self.folds)
-            if new is None and hard and self.options.branch_switching:
+            if new is None and hard and self.options.branch_switching and self._descent_failed_from is not state:
                 # the branch has ended (a fold): let the strip snap to the nearest stable state
                 new = self._jump(state, *load)
                 if new is not None:
@@ -435,6 +438,8 @@ class PathFollower:
         self._spent(result.iterations, "fold snaps", result.converged)
         if result.converged and result.positive_definite:
             return State(result.q, result.evaluation, compression, shear, True, result.iterations, branch_switched=True)
+        if not result.converged:
+            self._descent_failed_from = state
         model.restore_frames(saved)
         return None
 

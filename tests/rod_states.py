@@ -35,3 +35,13 @@ def twisted_rod_state(model, seed: int) -> np.ndarray:
         q = q + dq
         model.commit(q)
     return q
+
+
+def compressed_state(follower, ratio: float = 0.5, steps: int = 20):
+    """The follower's model compressed to dL/L = ratio in `steps` equal recorded steps, from the
+    first buckled state (PathFollower.start_compression then advance): the converged State."""
+    L = follower.model.strip.length
+    state = follower.start_compression(ratio * L / steps)
+    for k in range(2, steps + 1):
+        state = follower.advance(state, ratio * L * k / steps, 0.0)
+    return state

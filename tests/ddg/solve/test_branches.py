@@ -168,10 +168,10 @@ def test_past_the_pitchfork_the_path_slides_onto_us_along_the_critical_mode():
     strip = ddg.Strip.from_ratios(0.05, 0.5)
     L = strip.length
     model = make_model("rod", strip, 40)
+    from rod_states import compressed_state
+
     follower = PathFollower(model, ContinuationOptions(branch_switching=False))
-    state = follower.start_compression(0.5 * L / 20)
-    for k in range(2, 21):
-        state = follower.advance(state, 0.5 * L * k / 20, 0.0)
+    state = compressed_state(follower)
     state = follower.advance(state, 0.5 * L, 0.37 * L)  # past dW1 = 0.35 L on U, unstable
     assert not state.stable and phase_label(model, state.q, state.compression, state.shear) == "U"
     before = follower.iterations_by_phase["branch switching"]

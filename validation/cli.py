@@ -14,7 +14,8 @@ from ddg.cli_parser import OneLineParser
 def commands() -> dict[str, tuple[object, str]]:
     """Subcommand -> (the module that declares and runs it, its one-line help), in the order
     `python -m validation --help` lists them."""
-    from . import (benchmark, locking, narrow_limit, paper_figures, plate_gold, plate_mesh_scan, plate_modes, report,
+    from . import (benchmark, locking, midedge_convergence, narrow_limit, paper_figures, plate_gold, plate_mesh_scan,
+                   plate_modes, report,
                    ribbon_regularisation, score, wide_check)
     from .error_map import command as error_map
 
@@ -32,6 +33,8 @@ def commands() -> dict[str, tuple[object, str]]:
                                        "(data/narrow_limit)"),
         "wide-check": (wide_check, "the mid-edge plate's U branch against the shell's at W/L = 1/2 "
                                    "(data/midedge_wide)"),
+        "midedge-convergence": (midedge_convergence, "the mid-edge plate's dW1 over meshes refined across W and "
+                                                     "along L apart (data/midedge_convergence)"),
         "locking": (locking, "membrane locking of the mid-edge plate at three slendernesses (data/midedge_locking)"),
         "plate-modes": (plate_modes, "the plate's energies on exact smooth deformations, mode by mode "
                                      "(data/plate_modes)"),

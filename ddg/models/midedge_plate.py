@@ -49,14 +49,17 @@ MEMBRANES = ("psri", "full")
 
 class MidedgePlateModel(PlateModel):
     """The mid-edge plate of a Strip on a ghost-clamp structured mesh of ~`triangles` triangles
-    (or `rows` rows across W, or a given ghost_clamp_mesh)."""
+    (or `rows` rows across W, or a given ghost_clamp_mesh). membrane_alpha (with "psri"): the
+    constant-strain share instead of b^2 / h^2, e.g. 0 for the node-smoothed membrane alone."""
 
     name = MIDEDGE_PLATE
 
     def __init__(self, strip: Strip, triangles: int = DEFAULT_TRIANGLES, *, rows: int | None = None,
-                 mesh: PlateMesh | None = None, membrane: str = "psri"):
+                 mesh: PlateMesh | None = None, membrane: str = "psri", membrane_alpha: float | None = None):
         if membrane not in MEMBRANES:
             raise InputError(f"membrane = {membrane!r} must be one of {', '.join(MEMBRANES)}")
+        if membrane_alpha is not None and not (membrane == "psri" and 0.0 <= membrane_alpha <= 1.0):
+            raise InputError(f"membrane_alpha = {membrane_alpha!r} must lie in [0, 1], with membrane 'psri'")
         self.strip = strip
         self.membrane = membrane
         if mesh is None:
@@ -122,6 +125,8 @@ class MidedgePlateModel(PlateModel):
         self._plane_stress = plane_stress_matrix(E, b, nu)
         #: share of the full constant-strain membrane; the rest is the node-smoothed one
         self.membrane_alpha = min(1.0, (b / self._typical_spacing()) ** 2) if membrane == "psri" else 1.0
+        if membrane_alpha is not None:  # a fixed share, the same on every mesh (mesh studies)
+            self.membrane_alpha = float(membrane_alpha)
         self._membrane_share = self.membrane_alpha * self._membrane
         self._triangles = np.ascontiguousarray(tris, dtype=np.int64)
         self._face_edges = np.ascontiguousarray(face_edges, dtype=np.int64)

@@ -19,7 +19,8 @@ OLD_SPELLING = {"report": "validation.report", "score": "validation.score", "ben
                 "narrow-limit": "validation.narrow_limit", "wide-check": "validation.wide_check",
                 "locking": "validation.locking", "plate-modes": "validation.plate_modes",
                 "plate-mesh-scan": "validation.plate_mesh_scan", "paper-figures": "validation.paper_figures",
-                "ribbon-regularisation": "validation.ribbon_regularisation"}
+                "ribbon-regularisation": "validation.ribbon_regularisation",
+                "midedge-convergence": "validation.midedge_convergence"}
 
 
 def test_every_command_of_validation_is_a_subcommand():

@@ -179,6 +179,25 @@ def test_psri_weight_is_the_shells_b2_over_h2():
         MidedgePlateModel(s, rows=8, membrane="reduced")
 
 
+
+def test_a_fixed_membrane_share_mixes_the_two_membranes_linearly():
+    """membrane_alpha = a fixes the constant-strain share on every mesh: the stretching energy is
+    a E_full + (1 - a) E_smoothed (E_full at a = 1, E_smoothed at a = 0), the bending unchanged."""
+    s = strip(slenderness=1181.1)
+    rng = np.random.default_rng(3)
+    models = {a: MidedgePlateModel(s, rows=4, membrane_alpha=a) for a in (0.0, 0.3, 1.0)}
+    q = models[0.0].buckled_guess(0.3 * s.length) + 1e-3 * s.length * rng.standard_normal(models[0.0].n_dof)
+    parts = {a: m.evaluate(q, gradient=False).parts for a, m in models.items()}
+    assert models[0.3].membrane_alpha == 0.3
+    assert parts[0.3]["stretching"] == pytest.approx(0.3 * parts[1.0]["stretching"] + 0.7 * parts[0.0]["stretching"],
+                                                     rel=1e-12)
+    assert parts[0.3]["bending"] == parts[0.0]["bending"]
+    for bad in (-0.1, 1.5):
+        with pytest.raises(InputError, match=r"membrane_alpha = .* \[0, 1\]"):
+            MidedgePlateModel(s, rows=4, membrane_alpha=bad)
+    with pytest.raises(InputError, match="membrane_alpha"):
+        MidedgePlateModel(s, rows=4, membrane="full", membrane_alpha=0.5)
+
 def test_simulate_takes_the_membrane_of_the_mid_edge_plate_only():
     import ddg
 

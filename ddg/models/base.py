@@ -10,6 +10,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from ..solve.allocation import keep_large_blocks
 from ..solve.banded import SymmetricBanded
 
 
@@ -84,6 +85,8 @@ class BandedModel:
         """Zeroed gradient and flattened lower band for the compiled kernels to add into (empty
         where not asked)."""
         n = self.n_dof
+        if hessian:
+            keep_large_blocks(8 * (self.bandwidth + 1) * n)  # fine plates: no page faults per iteration
         return (np.zeros(n) if gradient else np.empty(0),
                 np.zeros((self.bandwidth + 1) * n) if hessian else np.empty(0))
 

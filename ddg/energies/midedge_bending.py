@@ -136,27 +136,45 @@ def _wing_gradient(wing, w):
 
 
 @njit(cache=True, forceinline=True)
-def _wing_block(edge, wing, w, ci, bi, cj, bj, scale, M):
-    """M (3, 3) = scale times the (i, j) block of wing w's part of Hess psi, for the wing's
-    vertices i, j with coefficients (c, b) = (-(1 - xi), -1) on v0, (-xi, 1) on v1, (1, 0) on o_w:
-    s [(c_i c_j / h^2 + b_i b_j / (2 l^2)) (t n^T + n t^T) - (b_i c_j n e_hat^T + c_i b_j e_hat n^T) / (l h)]."""
+def _add_wing_hessian(edge, wing, w, scale, rows, block, S, N):
+    """block += scale times wing w's part of Hess psi (module docstring), on the lower triangle
+    (row >= column) of the local block whose rows rows = (r0, r1, r2) start the coordinates of
+    (v0, v1, o_w): coefficients (c, b) = (-(1 - xi), -1) on v0, (-xi, 1) on v1, (1, 0) on o_w,
+    block (i, j) = s [(c_i c_j / h^2 + b_i b_j / (2 l^2)) S - (b_i c_j N + c_i b_j N^T) / (l h)]
+    with S = t n^T + n t^T and N = n e_hat^T. S, N (3, 3) scratch."""
     s = scale if w == 0 else -scale
-    h, length = wing[w, 6], edge[3]
-    alpha = s * (ci * cj / (h * h) + 0.5 * bi * bj / (length * length))
-    beta1 = s * bi * cj / (length * h)
-    beta2 = s * ci * bj / (length * h)
+    h, length, xi = wing[w, 6], edge[3], wing[w, 7]
     for k in range(3):
-        nk, tk, ek = wing[w, k], wing[w, 3 + k], edge[k]
         for m in range(3):
-            M[k, m] = (alpha * (tk * wing[w, m] + nk * wing[w, 3 + m])
-                       - beta1 * nk * edge[m] - beta2 * ek * wing[w, m])
+            S[k, m] = wing[w, 3 + k] * wing[w, m] + wing[w, k] * wing[w, 3 + m]
+            N[k, m] = wing[w, k] * edge[m]
+    c = (-(1.0 - xi), -xi, 1.0)
+    b = (-1.0, 1.0, 0.0)
+    inv_h2, inv_l2, inv_lh = 1.0 / (h * h), 0.5 / (length * length), 1.0 / (length * h)
+    for i in range(3):
+        r = rows[i]
+        alpha = s * (c[i] * c[i] * inv_h2 + b[i] * b[i] * inv_l2)
+        beta = s * b[i] * c[i] * inv_lh
+        for k in range(3):
+            for m in range(k + 1):
+                block[r + k, r + m] += alpha * S[k, m] - beta * (N[k, m] + N[m, k])
+        for j in range(i):
+            # the pair (i, j) written as (hi, lo), hi the one with the larger rows
+            hi, lo = (i, j) if rows[i] > rows[j] else (j, i)
+            rh, rl = rows[hi], rows[lo]
+            alpha = s * (c[hi] * c[lo] * inv_h2 + b[hi] * b[lo] * inv_l2)
+            beta1 = s * b[hi] * c[lo] * inv_lh
+            beta2 = s * c[hi] * b[lo] * inv_lh
+            for k in range(3):
+                for m in range(3):
+                    block[rh + k, rl + m] += alpha * S[k, m] - beta1 * N[k, m] - beta2 * N[m, k]
 
 
 @njit(cache=True)
 def hinge_angle(p, want_gradient, want_hessian, grad, hess):
     """Signed bending angle psi of the hinge p (4, 3) = (v0, v1, o_a, o_b), into grad (12,) and
     hess (12, 12) when asked (module docstring); returns psi."""
-    edge, wing, M = np.empty(4), np.empty((2, 8)), np.empty((3, 3))
+    edge, wing, S, N = np.empty(4), np.empty((2, 8)), np.empty((3, 3)), np.empty((3, 3))
     psi = _hinge_frame(p, 0, 1, 2, 3, edge, wing)
     if not want_gradient:
         return psi
@@ -172,18 +190,7 @@ def hinge_angle(p, want_gradient, want_hessian, grad, hess):
         return psi
     hess[:, :] = 0.0
     for w in range(2):
-        xi = wing[w, 7]
-        coefficient = ((-(1.0 - xi), -1.0), (-xi, 1.0), (1.0, 0.0))
-        slot = (0, 1, 2 + w)
-        for i in range(3):
-            for j in range(i + 1):
-                _wing_block(edge, wing, w, coefficient[i][0], coefficient[i][1], coefficient[j][0],
-                            coefficient[j][1], 1.0, M)
-                r, c = 3 * slot[i], 3 * slot[j]
-                for k in range(3):
-                    for m in range(3):
-                        if r + k >= c + m:
-                            hess[r + k, c + m] += M[k, m]
+        _add_wing_hessian(edge, wing, w, 1.0, (0, 3, 6 + 3 * w), hess, S, N)
     for r in range(12):
         for c in range(r):
             hess[c, r] = hess[r, c]
@@ -219,8 +226,8 @@ def add_midedge_terms(x, theta, stencil, hinge_slots, face_edges, K, vertex_dof,
     kphi = np.empty(3)
     edges = np.empty((3, 4))
     wings = np.empty((3, 2, 8))
-    M = np.empty((3, 3))
-    coefficient = np.empty((3, 2))
+    S = np.empty((3, 3))
+    N = np.empty((3, 3))
     for f in range(stencil.shape[0]):
         nv = 3
         while nv < 6 and stencil[f, nv] >= 0:
@@ -279,29 +286,10 @@ def add_midedge_terms(x, theta, stencil, hinge_slots, face_edges, K, vertex_dof,
             for i in range(3):
                 if hinge_slots[f, i, 0] < 0:
                     continue
-                # d2 phi_i = -d2 psi_i: the wings' blocks on (v0, v1, o_w), lower triangle only
-                for w in range(2):
-                    xi = wings[i, w, 7]
-                    coefficient[0, 0], coefficient[0, 1] = -(1.0 - xi), -1.0
-                    coefficient[1, 0], coefficient[1, 1] = -xi, 1.0
-                    coefficient[2, 0], coefficient[2, 1] = 1.0, 0.0
-                    slot0, slot1, slot2 = hinge_slots[f, i, 0], hinge_slots[f, i, 1], hinge_slots[f, i, 2 + w]
-                    for a in range(3):
-                        ra = base[slot0] if a == 0 else (base[slot1] if a == 1 else base[slot2])
-                        for c in range(3):
-                            rc = base[slot0] if c == 0 else (base[slot1] if c == 1 else base[slot2])
-                            if ra < rc:
-                                continue
-                            _wing_block(edges[i], wings[i], w, coefficient[a, 0], coefficient[a, 1],
-                                        coefficient[c, 0], coefficient[c, 1], -kphi[i], M)
-                            if ra > rc:
-                                for k in range(3):
-                                    for q in range(3):
-                                        block[ra + k, rc + q] += M[k, q]
-                            else:
-                                for k in range(3):
-                                    for q in range(k + 1):
-                                        block[ra + k, rc + q] += M[k, q]
+                # d2 phi_i = -d2 psi_i
+                r0, r1 = base[hinge_slots[f, i, 0]], base[hinge_slots[f, i, 1]]
+                _add_wing_hessian(edges[i], wings[i], 0, -kphi[i], (r0, r1, base[hinge_slots[f, i, 2]]), block, S, N)
+                _add_wing_hessian(edges[i], wings[i], 1, -kphi[i], (r0, r1, base[hinge_slots[f, i, 3]]), block, S, N)
             for r in range(m):
                 dr = dofs[r]
                 for c in range(r + 1):

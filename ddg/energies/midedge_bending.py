@@ -61,6 +61,8 @@ import math
 import numpy as np
 from numba import njit
 
+from ..assembly.band_scatter import prefetch_lower
+
 #: Role of a triangle on one of its edges: the edge's first triangle (and a free edge's only one),
 #: phi = theta; its second triangle, phi = -(theta + psi).
 ROLE_FIRST, ROLE_SECOND = 0, 1
@@ -198,6 +200,23 @@ def hinge_angle(p, want_gradient, want_hessian, grad, hess):
 
 
 # ---------------------------------------------------------------------------- assembly
+@njit(cache=True, forceinline=True)
+def _stencil_dofs(stencil, face_edges, vertex_dof, edge_dof, f, dofs):
+    """The global DOFs of triangle f's stencil in its local numbering (add_midedge_terms); returns
+    their number m."""
+    nv = 3
+    while nv < 6 and stencil[f, nv] >= 0:
+        nv += 1
+    for s in range(nv):
+        b = 3 * s if s < 3 else 3 * s + 3
+        v = stencil[f, s]
+        for k in range(3):
+            dofs[b + k] = vertex_dof[v, k]
+    for i in range(3):
+        dofs[9 + i] = edge_dof[face_edges[f, i]]
+    return 3 * nv + 3
+
+
 @njit(cache=True)
 def add_midedge_terms(x, theta, stencil, hinge_slots, face_edges, K, vertex_dof, edge_dof, n, grad, band,
                       want_gradient, want_hessian):
@@ -214,7 +233,9 @@ def add_midedge_terms(x, theta, stencil, hinge_slots, face_edges, K, vertex_dof,
     Local numbering of a triangle's stencil: its own vertices' coordinates 0-8, its three angles
     9-11, the far vertices' coordinates from 12 on. The Hessian J^T K J - sum_i kphi_i Hess(psi_i),
     kphi = K phi, is formed on the lower triangle of the local block only and added into the band at
-    |r - c| n + min(r, c)."""
+    |r - c| n + min(r, c), the next triangle's entries prefetched meanwhile (ddg.assembly.band_scatter:
+    the wide stencil's entries are often not yet in cache; the membranes' narrower ones mostly are,
+    and they are not prefetched)."""
     energy = 0.0
     dofs = np.empty(21, dtype=np.int64)
     J = np.zeros((3, 21))
@@ -228,21 +249,19 @@ def add_midedge_terms(x, theta, stencil, hinge_slots, face_edges, K, vertex_dof,
     wings = np.empty((3, 2, 8))
     S = np.empty((3, 3))
     N = np.empty((3, 3))
+    ahead = np.empty(21, dtype=np.int64)
     for f in range(stencil.shape[0]):
-        nv = 3
-        while nv < 6 and stencil[f, nv] >= 0:
-            nv += 1
-        m = 3 * nv + 3
+        if want_hessian and f + 1 < stencil.shape[0]:
+            prefetch_lower(band, n, ahead, _stencil_dofs(stencil, face_edges, vertex_dof, edge_dof, f + 1, ahead))
+        m = _stencil_dofs(stencil, face_edges, vertex_dof, edge_dof, f, dofs)
+        nv = m // 3 - 1
         for s in range(nv):
             v = stencil[f, s]
-            b = 3 * s if s < 3 else 3 * s + 3
-            base[s] = b
+            base[s] = 3 * s if s < 3 else 3 * s + 3
             for k in range(3):
                 P[s, k] = x[v, k]
-                dofs[b + k] = vertex_dof[v, k]
         for i in range(3):
             e = face_edges[f, i]
-            dofs[9 + i] = edge_dof[e]
             if hinge_slots[f, i, 0] < 0:
                 phi[i] = theta[e]
                 J[i, 9 + i] = 1.0

@@ -13,7 +13,9 @@ of 1e-3 L of the nodes and random edge angles of 1e-2 (no term vanishes), and ti
   membrane (ddg.energies.membrane), the smoothed membrane (ddg.energies.smoothed_membrane) and the
   mid-edge bending (ddg.energies.midedge_bending), each for the energy only, energy + gradient and
   energy + gradient + Hessian;
-- the whole `model.evaluate` (gathers, zeroed accumulators, the three kernels, the Evaluation).
+- the whole `model.evaluate` (gathers, zeroed accumulators, the three kernels, the Evaluation);
+- (this tree's stencils only) the band additions alone: the lower band entries of each bending
+  stencil and each patch added 0.0 with nothing computed, what the band storage costs by itself.
 
 A measurement is `calls` calls (as many as fit in --budget seconds, 5 to 500), their median per
 call; each round runs in a fresh child process whose working directory is the source tree (this
@@ -47,6 +49,7 @@ TARGET_US = 0.4
 CHILD = r"""
 import json, statistics, sys, time
 import numpy as np
+from numba import njit
 import ddg
 from ddg.models.midedge_plate import MidedgePlateModel
 from ddg.energies.membrane import add_membrane_terms
@@ -97,6 +100,33 @@ def timed(call):
     return statistics.median(times)
 
 
+@njit
+def scatter_alone(stencil, face_edges, node_pointer, patch_nodes, vertex_dof, edge_dof, n, band, which):
+    '''The band additions alone (0.0 added at each lower entry of each element, nothing computed):
+    which = 0 the bending stencils (the model's triangle order), 1 the smoothed membrane's patches.'''
+    dofs = np.empty(64, dtype=np.int64)
+    count = stencil.shape[0] if which == 0 else node_pointer.shape[0] - 1
+    for e in range(count):
+        m = 0
+        if which == 0:
+            for s in range(6):
+                if stencil[e, s] >= 0:
+                    for k in range(3):
+                        dofs[m] = vertex_dof[stencil[e, s], k]
+                        m += 1
+            for i in range(3):
+                dofs[m] = edge_dof[face_edges[e, i]]
+                m += 1
+        else:
+            for j in range(node_pointer[e], node_pointer[e + 1]):
+                for k in range(3):
+                    dofs[m] = vertex_dof[patch_nodes[j], k]
+                    m += 1
+        for a in range(m):
+            for b in range(a + 1):
+                band[abs(dofs[a] - dofs[b]) * n + min(dofs[a], dofs[b])] += 0.0
+
+
 out = []
 for R in rows:
     strip = ddg.Strip.from_ratios(1 / 6, 0.5)
@@ -117,6 +147,11 @@ for R in rows:
            "patches": int(len(model._patches[0]) - 1), "n_dof": int(model.n_dof), "bandwidth": int(model.bandwidth),
            "kernels": [[timed(lambda: call(g, h)) for g, h in modes] for call in calls],
            "evaluate": [timed(lambda: model.evaluate(q, gradient=g, hessian=h)) for g, h in modes]}
+    if hasattr(model, "_by_x"):
+        t, patches = model._by_x, model._patches
+        row["scatter_alone"] = [timed(lambda: scatter_alone(t["stencil"], t["face_edges"], patches[4], patches[5],
+                                                            model._node_dofs, model._edge_dofs, model.n_dof, band,
+                                                            which)) for which in (0, 1)]
     out.append(row)
 print(json.dumps(out))
 """
@@ -136,6 +171,8 @@ def _merge(best, new):
     for b, r in zip(best, new):
         b["kernels"] = [[min(u, v) for u, v in zip(x, y)] for x, y in zip(b["kernels"], r["kernels"])]
         b["evaluate"] = [min(u, v) for u, v in zip(b["evaluate"], r["evaluate"])]
+        if "scatter_alone" in b:
+            b["scatter_alone"] = [min(u, v) for u, v in zip(b["scatter_alone"], r["scatter_alone"])]
     return best
 
 
@@ -157,8 +194,8 @@ def markdown(report: dict) -> str:
     for k, kernel in enumerate(KERNELS):
         unit = {"membrane": ("triangle", "triangles"), "smoothed membrane": ("patch", "patches"),
                 "mid-edge bending": ("hinge", "hinges")}[kernel]
-        header = ["rows", "triangles", f"{unit[1]}"] + [f"{m[0]}: us / triangle" for m in MODES] + [
-            f"E+G+H us / {unit[0]}", "E+G+H call us"]
+        header = ["rows", "triangles", f"elements ({unit[1]})"] + [f"{m[0]}: us / triangle" for m in MODES] + [
+            f"E+G+H us / {unit[0]}", "E+G+H call us"] + (["band additions alone: us / triangle"] if k > 0 else [])
         rows = []
         for i, r in enumerate(best):
             o = other[i] if other else None
@@ -167,10 +204,15 @@ def markdown(report: dict) -> str:
                 cells.append(_cell(r["kernels"][k][j], o["kernels"][k][j] if o else None, r["triangles"]))
             cells.append(_cell(r["kernels"][k][2], o["kernels"][k][2] if o else None, r[unit[1]]))
             cells.append(f"{1e6 * r['kernels'][k][2]:.1f}" + (f" (was {1e6 * o['kernels'][k][2]:.1f})" if o else ""))
+            if k > 0:
+                alone = r.get("scatter_alone")
+                cells.append(f"{1e6 * alone[2 - k] / r['triangles']:.3f}" if alone else "")
             rows.append(cells)
         lines += [f"## {kernel}", "", markdown_table(header, rows), ""]
+    lines += ["band additions alone: the same lower band entries of each element (the bending's stencils, the "
+              "patches) added 0.0, with nothing computed: what the band storage costs these kernels by itself.", ""]
     header = ["rows", "n_dof", "bandwidth"] + [f"evaluate, {m[0]}: us" for m in MODES] + [
-        "E+G+H us / triangle", "three kernels E+G+H us / triangle"]
+        "E+G+H us / triangle", "three kernels E+G+H us / triangle", "E+G+H outside the kernels us"]
     rows = []
     for i, r in enumerate(best):
         o = other[i] if other else None
@@ -181,10 +223,14 @@ def markdown(report: dict) -> str:
         cells.append(_cell(r["evaluate"][2], o["evaluate"][2] if o else None, r["triangles"]))
         three = sum(r["kernels"][k][2] for k in range(3))
         cells.append(_cell(three, sum(o["kernels"][k][2] for k in range(3)) if o else None, r["triangles"]))
+        cells.append(f"{1e6 * (r['evaluate'][2] - three):.0f}"
+                     + (f" (was {1e6 * (o['evaluate'][2] - sum(o['kernels'][k][2] for k in range(3))):.0f})"
+                        if o else ""))
         rows.append(cells)
     lines += ["## model.evaluate", "", markdown_table(header, rows), "",
               "evaluate includes what the kernels do not: the gather of q into positions and angles, the zeroed "
-              "gradient and band ((bandwidth + 1) n doubles) and the Evaluation.", "",
+              "gradient and band ((bandwidth + 1) n doubles, 98 MB at 28 rows: a fresh allocation each call, whose "
+              "pages the kernels then touch for the first time) and the Evaluation.", "",
               f"Trees: {report['trees']}; {report['rounds']} rounds, {report['budget_s']} s per measurement; load "
               f"average {report['load_before']} before, {report['load_after']} after; "
               f"{report['machine'].get('cpu_model', '?')}, {report['machine'].get('thread_env')}.", ""]

@@ -22,6 +22,7 @@ from ddg.assembly.band_scatter import add_symmetric_block
 from ddg.energies.membrane import add_membrane_terms
 from ddg.energies.midedge_bending import ROLE_FIRST, ROLE_SECOND, add_midedge_terms
 from ddg.energies.smoothed_membrane import add_smoothed_membrane_terms
+from ddg.geometry.plate_mesh import PlateMesh, ghost_clamp_mesh
 from ddg.geometry.strip import Strip
 from ddg.models.midedge_plate import MidedgePlateModel
 
@@ -528,3 +529,29 @@ def test_midedge_bending_is_the_reference(model, seed):
     reference = run(reference_bending, model, x, theta, model._triangles, model._face_edges, roles,
                     model._hinge_of_edge, model._hinges, model._bending, model._node_dofs, model._edge_dofs)
     assert_same(new, reference)
+
+
+def split_mesh_model():
+    """The W/L = 1/6 plate on 4 rows with its triangle nearest the centre split at its centroid:
+    a vertex of three triangles, where two hinges of one triangle have the same far vertex (its
+    stencil holds that vertex once)."""
+    strip = Strip.from_ratios(1 / 6, 0.5)
+    base = ghost_clamp_mesh(strip.length, strip.width, rows=4)
+    centres = base.nodes[base.triangles].mean(axis=1)
+    f = int(np.argmin(np.abs(centres[:, 0] - 0.5 * strip.length) + np.abs(centres[:, 1])))
+    a, b, d = base.triangles[f]
+    nodes = np.vstack([base.nodes, centres[f]])
+    c = len(nodes) - 1
+    triangles = np.vstack([np.delete(base.triangles, f, axis=0), [[a, b, c], [b, d, c], [d, a, c]]])
+    order = np.lexsort((nodes[:, 1], nodes[:, 0]))
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    mesh = PlateMesh(nodes[order], rank[triangles], strip.length, strip.width, 0.0, 0.0)
+    return MidedgePlateModel(strip, mesh=mesh)
+
+
+def test_midedge_bending_is_the_reference_where_two_hinges_share_their_far_vertex():
+    model = split_mesh_model()
+    hinges_second = (model._hinge_slots[:, :, 0] >= 0).sum(axis=1)
+    assert (hinges_second > (model._stencil[:, 3:] >= 0).sum(axis=1)).sum() == 1
+    test_midedge_bending_is_the_reference(model, 0)

@@ -201,6 +201,19 @@ def hinge_angle(p, want_gradient, want_hessian, grad, hess):
 
 # ---------------------------------------------------------------------------- assembly
 @njit(cache=True, forceinline=True)
+def _lower_jkj(K, f, J, KJ, block, m):
+    """block[r, c] = (J^T K_f J)[r, c] for c <= r < m (KJ (3, m) scratch)."""
+    for i in range(3):
+        k0, k1, k2 = K[f, i, 0], K[f, i, 1], K[f, i, 2]
+        for c in range(m):
+            KJ[i, c] = k0 * J[0, c] + k1 * J[1, c] + k2 * J[2, c]
+    for r in range(m):
+        j0, j1, j2 = J[0, r], J[1, r], J[2, r]
+        for c in range(r + 1):
+            block[r, c] = j0 * KJ[0, c] + j1 * KJ[1, c] + j2 * KJ[2, c]
+
+
+@njit(cache=True, forceinline=True)
 def _stencil_dofs(stencil, face_edges, vertex_dof, edge_dof, f, dofs):
     """The global DOFs of triangle f's stencil in its local numbering (add_midedge_terms); returns
     their number m."""
@@ -295,13 +308,15 @@ def add_midedge_terms(x, theta, stencil, hinge_slots, face_edges, K, vertex_dof,
         for c in range(m):
             grad[dofs[c]] += J[0, c] * kphi[0] + J[1, c] * kphi[1] + J[2, c] * kphi[2]
         if want_hessian:
-            for i in range(3):
-                for c in range(m):
-                    KJ[i, c] = K[f, i, 0] * J[0, c] + K[f, i, 1] * J[1, c] + K[f, i, 2] * J[2, c]
-            for r in range(m):
-                j0, j1, j2 = J[0, r], J[1, r], J[2, r]
-                for c in range(r + 1):
-                    block[r, c] = j0 * KJ[0, c] + j1 * KJ[1, c] + j2 * KJ[2, c]
+            # m = 12 + 3 (far vertices): each size compiled with its loop bounds known
+            if m == 21:
+                _lower_jkj(K, f, J, KJ, block, 21)
+            elif m == 18:
+                _lower_jkj(K, f, J, KJ, block, 18)
+            elif m == 15:
+                _lower_jkj(K, f, J, KJ, block, 15)
+            else:
+                _lower_jkj(K, f, J, KJ, block, 12)
             for i in range(3):
                 if hinge_slots[f, i, 0] < 0:
                     continue

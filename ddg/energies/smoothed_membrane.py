@@ -87,6 +87,19 @@ def plane_stress_matrix(young_modulus: float, thickness: float, poisson_ratio: f
                                                                     [nu, 0.0, 1.0]])
 
 
+@njit(cache=True, forceinline=True)
+def _lower_gcg(A, C, G, CG, block, nl):
+    """block[r, c] = A (G^T C G)[r, c] for c <= r < nl (CG (3, nl) scratch)."""
+    for a in range(3):
+        ca0, ca1, ca2 = A * C[a, 0], A * C[a, 1], A * C[a, 2]
+        for c in range(nl):
+            CG[a, c] = ca0 * G[0, c] + ca1 * G[1, c] + ca2 * G[2, c]
+    for r in range(nl):
+        g0, g1, g2 = G[0, r], G[1, r], G[2, r]
+        for c in range(r + 1):
+            block[r, c] = g0 * CG[0, c] + g1 * CG[1, c] + g2 * CG[2, c]
+
+
 @njit(cache=True)
 def add_smoothed_membrane_terms(x, triangles, T, abar, pointer, patch_faces, weights, patch_area, node_pointer,
                                 patch_nodes, face_slots, C, scale, vertex_dof, n, grad, band, want_gradient,
@@ -150,14 +163,10 @@ def add_smoothed_membrane_terms(x, triangles, T, abar, pointer, patch_faces, wei
         for c in range(nl):
             grad[dofs[c]] += G[0, c] * s[0] + G[1, c] * s[1] + G[2, c] * s[2]
         if want_hessian:
-            for a in range(3):
-                ca0, ca1, ca2 = A * C[a, 0], A * C[a, 1], A * C[a, 2]
-                for c in range(nl):
-                    CG[a, c] = ca0 * G[0, c] + ca1 * G[1, c] + ca2 * G[2, c]
-            for r in range(nl):
-                g0, g1, g2 = G[0, r], G[1, r], G[2, r]
-                for c in range(r + 1):
-                    block[r, c] = g0 * CG[0, c] + g1 * CG[1, c] + g2 * CG[2, c]
+            if nl == 21:  # an interior patch of 6 triangles: compiled with its loop bounds known
+                _lower_gcg(A, C, G, CG, block, 21)
+            else:
+                _lower_gcg(A, C, G, CG, block, nl)
             for m in range(first, last):
                 f = patch_faces[m]
                 w = weights[m]

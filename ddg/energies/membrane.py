@@ -19,8 +19,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..assembly.band_scatter import add_symmetric_block
-
 _S = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]]])
 
 
@@ -45,57 +43,59 @@ def face_membrane_matrices(nodes: np.ndarray, triangles: np.ndarray, young_modul
 @njit(cache=True)
 def add_membrane_terms(x, triangles, C, abar, vertex_dof, n, grad, band, want_gradient, want_hessian):
     """Membrane energy sum_f 1/2 delta^T C_f delta; adds the gradient into grad (n,) and the
-    Hessian into the flattened lower band (ddg.assembly.band_scatter). vertex_dof (N, 3)."""
+    Hessian into the flattened lower band (ddg.assembly.band_scatter). vertex_dof (N, 3).
+
+    The 9 x 9 Hessian of a triangle is formed on its lower triangle only (local order p0, p1, p2)
+    and added into the band at |r - c| n + min(r, c)."""
     energy = 0.0
     dofs = np.empty(9, dtype=np.int64)
     J = np.empty((3, 9))
-    block = np.empty((9, 9))
-    delta = np.empty(3)
-    Cd = np.empty(3)
     CJ = np.empty((3, 9))
+    block = np.empty((9, 9))
     for f in range(triangles.shape[0]):
         p0, p1, p2 = triangles[f, 0], triangles[f, 1], triangles[f, 2]
-        e1 = x[p1] - x[p0]
-        e2 = x[p2] - x[p0]
-        delta[0] = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] - abar[f, 0]
-        delta[1] = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2] - abar[f, 1]
-        delta[2] = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2] - abar[f, 2]
-        Cd0 = C[f, 0, 0] * delta[0] + C[f, 0, 1] * delta[1] + C[f, 0, 2] * delta[2]
-        Cd1 = C[f, 1, 0] * delta[0] + C[f, 1, 1] * delta[1] + C[f, 1, 2] * delta[2]
-        Cd2 = C[f, 2, 0] * delta[0] + C[f, 2, 1] * delta[1] + C[f, 2, 2] * delta[2]
-        Cd[0], Cd[1], Cd[2] = Cd0, Cd1, Cd2
-        energy += 0.5 * (delta[0] * Cd[0] + delta[1] * Cd[1] + delta[2] * Cd[2])
+        a0, a1, a2 = x[p1, 0] - x[p0, 0], x[p1, 1] - x[p0, 1], x[p1, 2] - x[p0, 2]
+        b0, b1, b2 = x[p2, 0] - x[p0, 0], x[p2, 1] - x[p0, 1], x[p2, 2] - x[p0, 2]
+        d0 = a0 * a0 + a1 * a1 + a2 * a2 - abar[f, 0]
+        d1 = a0 * b0 + a1 * b1 + a2 * b2 - abar[f, 1]
+        d2 = b0 * b0 + b1 * b1 + b2 * b2 - abar[f, 2]
+        Cd0 = C[f, 0, 0] * d0 + C[f, 0, 1] * d1 + C[f, 0, 2] * d2
+        Cd1 = C[f, 1, 0] * d0 + C[f, 1, 1] * d1 + C[f, 1, 2] * d2
+        Cd2 = C[f, 2, 0] * d0 + C[f, 2, 1] * d1 + C[f, 2, 2] * d2
+        energy += 0.5 * (d0 * Cd0 + d1 * Cd1 + d2 * Cd2)
         if not want_gradient:
             continue
-        for k in range(3):
+        # a11 = e1.e1, a12 = e1.e2, a22 = e2.e2 in (p0, p1, p2), e1 = p1 - p0, e2 = p2 - p0
+        for k, ek, fk in ((0, a0, b0), (1, a1, b1), (2, a2, b2)):
             dofs[k] = vertex_dof[p0, k]
             dofs[3 + k] = vertex_dof[p1, k]
             dofs[6 + k] = vertex_dof[p2, k]
-            # a11 = e1.e1, a12 = e1.e2, a22 = e2.e2 in (p0, p1, p2)
-            J[0, k], J[0, 3 + k], J[0, 6 + k] = -2.0 * e1[k], 2.0 * e1[k], 0.0
-            J[1, k], J[1, 3 + k], J[1, 6 + k] = -(e1[k] + e2[k]), e2[k], e1[k]
-            J[2, k], J[2, 3 + k], J[2, 6 + k] = -2.0 * e2[k], 0.0, 2.0 * e2[k]
+            J[0, k], J[0, 3 + k], J[0, 6 + k] = -2.0 * ek, 2.0 * ek, 0.0
+            J[1, k], J[1, 3 + k], J[1, 6 + k] = -(ek + fk), fk, ek
+            J[2, k], J[2, 3 + k], J[2, 6 + k] = -2.0 * fk, 0.0, 2.0 * fk
         for c in range(9):
-            grad[dofs[c]] += J[0, c] * Cd[0] + J[1, c] * Cd[1] + J[2, c] * Cd[2]
+            grad[dofs[c]] += J[0, c] * Cd0 + J[1, c] * Cd1 + J[2, c] * Cd2
         if not want_hessian:
             continue
         for a in range(3):
             for c in range(9):
                 CJ[a, c] = C[f, a, 0] * J[0, c] + C[f, a, 1] * J[1, c] + C[f, a, 2] * J[2, c]
         for r in range(9):
-            for c in range(9):
-                block[r, c] = J[0, r] * CJ[0, c] + J[1, r] * CJ[1, c] + J[2, r] * CJ[2, c]
+            j0, j1, j2 = J[0, r], J[1, r], J[2, r]
+            for c in range(r + 1):
+                block[r, c] = j0 * CJ[0, c] + j1 * CJ[1, c] + j2 * CJ[2, c]
         # constant Hessians of a11 (on p0, p1), a22 (on p0, p2) and a12, times (C delta)_k
-        s11, s12, s22 = 2.0 * Cd[0], Cd[1], 2.0 * Cd[2]
+        s11, s12, s22 = 2.0 * Cd0, Cd1, 2.0 * Cd2
         for k in range(3):
             block[k, k] += s11 + 2.0 * s12 + s22
             block[3 + k, 3 + k] += s11
             block[6 + k, 6 + k] += s22
-            block[k, 3 + k] -= s11 + s12
             block[3 + k, k] -= s11 + s12
-            block[k, 6 + k] -= s22 + s12
             block[6 + k, k] -= s22 + s12
-            block[3 + k, 6 + k] += s12
             block[6 + k, 3 + k] += s12
-        add_symmetric_block(band, n, dofs, block)
+        for r in range(9):
+            dr = dofs[r]
+            for c in range(r + 1):
+                dc = dofs[c]
+                band[abs(dr - dc) * n + min(dr, dc)] += block[r, c]
     return energy

@@ -30,14 +30,29 @@ objectivity is kept, as phi depends on angles only). The bending energy of the t
 
 the Kirchhoff plate's density for the mixed curvature tensor M, i.e. E_f = 1/2 phi^T K_f phi with
 a constant 3 x 3 K_f per triangle (`face_bending_matrices`). phi is linear in theta and psi, so
-the derivatives need only psi's gradient and Hessian in the hinge's 12 coordinates:
+the derivatives need only psi's gradient and Hessian in the hinge's 12 coordinates.
 
-  psi = atan2(Y, X),  X = u_a . u_b,  Y = (u_b x u_a) . e / |e|,
+The hinge angle. With e = v1 - v0 (length l, unit e_hat), the unnormalised normals
+u_a = e x (o_a - v0) of a = (v0, v1, o_a) and u_b = (v0 - v1) x (o_b - v1) of b = (v1, v0, o_b):
 
-u_a = (p1 - p0) x (p2 - p0) the unnormalised normal of a = (v0, v1, o_a) and u_b that of
-b = (v1, v0, o_b), e = v1 - v0. u is bilinear in the vertices (du/dp_i = -[c_i]x with
-c_i = p_{i+1} - p_{i+2}; the Hessian of w . u is the block matrix B(w) of ddg.energies.hinge_bending),
-so X and Y have closed-form Hessians, and psi's follows from atan2's.
+  psi = atan2(Y, X),  X = u_a . u_b,  Y = (u_b x u_a) . e / l.
+
+Its derivatives in closed form (as Bridson et al. 2003 and Tamstorf & Grinspun 2013 write them),
+per wing w = a, b of the hinge with its far vertex o_w: q_w = e x (o_w - v0) (= u_a, = -u_b),
+n = q_w / |q_w|, t = e_hat x n, h = |q_w| / l the height of o_w over the edge, xi = (o_w - v0) . e / l^2
+the foot of that height along the edge, and s = +1 on a, -1 on b. psi turns with the wings about
+the edge, so
+
+  d psi / d o_w = s n / h,  d psi / d v1 = -xi s n / h,  d psi / d v0 = -(1 - xi) s n / h   (summed over w),
+
+and Hess psi is the sum of each wing's symmetric 9 x 9 on (v0, v1, o_w) (no o_a - o_b block), with
+coefficients c = (-(1 - xi), -xi, 1) and b = (-1, 1, 0) over (v0, v1, o_w) (b: e's), block (i, j)
+
+  s [(c_i c_j / h^2 + b_i b_j / (2 l^2)) (t n^T + n t^T) - (b_i c_j n e_hat^T + c_i b_j e_hat n^T) / (l h)]
+
+(from d(n / h) / d(o_w - v0) = (t n^T + n t^T) / h^2 and the chain rule through xi and l; the
+antisymmetric parts of the two wings' second derivatives in e alone cancel, so each is written
+symmetric).
 """
 from __future__ import annotations
 
@@ -46,7 +61,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..assembly.band_scatter import add_symmetric_block
+from ..assembly.band_scatter import prefetch_lower
 
 #: Role of a triangle on one of its edges: the edge's first triangle (and a free edge's only one),
 #: phi = theta; its second triangle, phi = -(theta + psi).
@@ -81,271 +96,240 @@ def face_bending_matrices(nodes: np.ndarray, triangles: np.ndarray, young_modulu
 
 # ---------------------------------------------------------------------------- the hinge angle
 @njit(cache=True, forceinline=True)
-def _cross(a, b, out):
-    out[0] = a[1] * b[2] - a[2] * b[1]
-    out[1] = a[2] * b[0] - a[0] * b[2]
-    out[2] = a[0] * b[1] - a[1] * b[0]
+def _hinge_frame(P, i0, i1, ia, ib, edge, wing):
+    """psi of the hinge (v0, v1, o_a, o_b) = rows (i0, i1, ia, ib) of P; with its frame (module
+    docstring): edge = (e_hat, l), wing[w] = (n, t, h, xi) of w = a, b. Returns psi."""
+    e0, e1, e2 = P[i1, 0] - P[i0, 0], P[i1, 1] - P[i0, 1], P[i1, 2] - P[i0, 2]
+    ll = e0 * e0 + e1 * e1 + e2 * e2
+    length = math.sqrt(ll)
+    inv_l = 1.0 / length
+    # q_w = e x d_w, d_w = o_w - v0 (u_a = q_a, u_b = -q_b)
+    da0, da1, da2 = P[ia, 0] - P[i0, 0], P[ia, 1] - P[i0, 1], P[ia, 2] - P[i0, 2]
+    db0, db1, db2 = P[ib, 0] - P[i0, 0], P[ib, 1] - P[i0, 1], P[ib, 2] - P[i0, 2]
+    qa0, qa1, qa2 = e1 * da2 - e2 * da1, e2 * da0 - e0 * da2, e0 * da1 - e1 * da0
+    qb0, qb1, qb2 = e1 * db2 - e2 * db1, e2 * db0 - e0 * db2, e0 * db1 - e1 * db0
+    # psi = atan2(Y, X), X = u_a . u_b, Y = (u_b x u_a) . e / l
+    X = -(qa0 * qb0 + qa1 * qb1 + qa2 * qb2)
+    Y = -((qb1 * qa2 - qb2 * qa1) * e0 + (qb2 * qa0 - qb0 * qa2) * e1 + (qb0 * qa1 - qb1 * qa0) * e2) * inv_l
+    psi = math.atan2(Y, X)
+    h0, h1, h2 = e0 * inv_l, e1 * inv_l, e2 * inv_l
+    edge[0], edge[1], edge[2], edge[3] = h0, h1, h2, length
+    for w in range(2):
+        if w == 0:
+            q0, q1, q2, xi = qa0, qa1, qa2, (da0 * e0 + da1 * e1 + da2 * e2) / ll
+        else:
+            q0, q1, q2, xi = qb0, qb1, qb2, (db0 * e0 + db1 * e1 + db2 * e2) / ll
+        norm = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
+        inv = 1.0 / norm
+        n0, n1, n2 = q0 * inv, q1 * inv, q2 * inv
+        wing[w, 0], wing[w, 1], wing[w, 2] = n0, n1, n2
+        wing[w, 3], wing[w, 4], wing[w, 5] = h1 * n2 - h2 * n1, h2 * n0 - h0 * n2, h0 * n1 - h1 * n0
+        wing[w, 6] = norm * inv_l
+        wing[w, 7] = xi
+    return psi
 
 
 @njit(cache=True, forceinline=True)
-def _normal_jacobian(p, slots, J):
-    """J (3, 12) = du/dq of u = (p1 - p0) x (p2 - p0) for the triangle on hinge slots (s0, s1, s2):
-    du = sum_i dp_i x c_i, c_i = p_{i+1} - p_{i+2}, i.e. du/dp_i = -[c_i]x."""
-    J[:, :] = 0.0
-    for i in range(3):
-        a, b = slots[(i + 1) % 3], slots[(i + 2) % 3]
-        c0, c1, c2 = p[a, 0] - p[b, 0], p[a, 1] - p[b, 1], p[a, 2] - p[b, 2]
-        col = 3 * slots[i]
-        # -[c]x = [[0, c2, -c1], [-c2, 0, c0], [c1, -c0, 0]]
-        J[0, col + 1], J[0, col + 2] = c2, -c1
-        J[1, col + 0], J[1, col + 2] = -c2, c0
-        J[2, col + 0], J[2, col + 1] = c1, -c0
+def _wing_gradient(wing, w):
+    """(s n / h, xi) of wing w: d psi / d o_w = s n / h, d psi / d v1 = -xi s n / h, d psi / d v0 =
+    -(1 - xi) s n / h (s = +1 on a, -1 on b)."""
+    s = (1.0 if w == 0 else -1.0) / wing[w, 6]
+    return s * wing[w, 0], s * wing[w, 1], s * wing[w, 2]
 
 
 @njit(cache=True, forceinline=True)
-def _add_bilinear(slots, w, scale, H):
-    """H += scale * Hessian of w . u in the 12 hinge coordinates (u of the triangle on `slots`):
-    blocks (i, i+1) = -[w]x, (i+1, i) = +[w]x."""
-    # -[w]x = [[0, w2, -w1], [-w2, 0, w0], [w1, -w0, 0]] (scalars: no array per call)
-    w0, w1, w2 = scale * w[0], scale * w[1], scale * w[2]
+def _add_wing_hessian(edge, wing, w, scale, rows, block, S, N):
+    """block += scale times wing w's part of Hess psi (module docstring), on the lower triangle
+    (row >= column) of the local block whose rows rows = (r0, r1, r2) start the coordinates of
+    (v0, v1, o_w): coefficients (c, b) = (-(1 - xi), -1) on v0, (-xi, 1) on v1, (1, 0) on o_w,
+    block (i, j) = s [(c_i c_j / h^2 + b_i b_j / (2 l^2)) S - (b_i c_j N + c_i b_j N^T) / (l h)]
+    with S = t n^T + n t^T and N = n e_hat^T. S, N (3, 3) scratch."""
+    s = scale if w == 0 else -scale
+    h, length, xi = wing[w, 6], edge[3], wing[w, 7]
+    for k in range(3):
+        for m in range(3):
+            S[k, m] = wing[w, 3 + k] * wing[w, m] + wing[w, k] * wing[w, 3 + m]
+            N[k, m] = wing[w, k] * edge[m]
+    c = (-(1.0 - xi), -xi, 1.0)
+    b = (-1.0, 1.0, 0.0)
+    inv_h2, inv_l2, inv_lh = 1.0 / (h * h), 0.5 / (length * length), 1.0 / (length * h)
     for i in range(3):
-        r, c = 3 * slots[i], 3 * slots[(i + 1) % 3]
-        H[r + 0, c + 1] += w2
-        H[c + 1, r + 0] += w2
-        H[r + 0, c + 2] -= w1
-        H[c + 2, r + 0] -= w1
-        H[r + 1, c + 0] -= w2
-        H[c + 0, r + 1] -= w2
-        H[r + 1, c + 2] += w0
-        H[c + 2, r + 1] += w0
-        H[r + 2, c + 0] += w1
-        H[c + 0, r + 2] += w1
-        H[r + 2, c + 1] -= w0
-        H[c + 1, r + 2] -= w0
-
-
-_SLOTS_A = np.array([0, 1, 2], dtype=np.int64)  # a = (v0, v1, o_a)
-_SLOTS_B = np.array([1, 0, 3], dtype=np.int64)  # b = (v1, v0, o_b)
-_JE = np.hstack([-np.eye(3), np.eye(3), np.zeros((3, 6))])  # de/dq of the hinge edge e = v1 - v0
+        r = rows[i]
+        alpha = s * (c[i] * c[i] * inv_h2 + b[i] * b[i] * inv_l2)
+        beta = s * b[i] * c[i] * inv_lh
+        for k in range(3):
+            for m in range(k + 1):
+                block[r + k, r + m] += alpha * S[k, m] - beta * (N[k, m] + N[m, k])
+        for j in range(i):
+            # the pair (i, j) written as (hi, lo), hi the one with the larger rows
+            hi, lo = (i, j) if rows[i] > rows[j] else (j, i)
+            rh, rl = rows[hi], rows[lo]
+            alpha = s * (c[hi] * c[lo] * inv_h2 + b[hi] * b[lo] * inv_l2)
+            beta1 = s * b[hi] * c[lo] * inv_lh
+            beta2 = s * c[hi] * b[lo] * inv_lh
+            for k in range(3):
+                for m in range(3):
+                    block[rh + k, rl + m] += alpha * S[k, m] - beta1 * N[k, m] - beta2 * N[m, k]
 
 
 @njit(cache=True)
 def hinge_angle(p, want_gradient, want_hessian, grad, hess):
     """Signed bending angle psi of the hinge p (4, 3) = (v0, v1, o_a, o_b), into grad (12,) and
     hess (12, 12) when asked (module docstring); returns psi."""
-    Ja, Jb, HX, HT, t3, dX, dT, dl, dY = (np.empty((3, 12)), np.empty((3, 12)), np.empty((12, 12)),
-                                          np.empty((12, 12)), np.empty((3, 12)), np.empty(12), np.empty(12),
-                                          np.empty(12), np.empty(12))
-    return hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT, t3, dX, dT, dl, dY,
-                            np.empty((6, 3)))
-
-
-@njit(cache=True, forceinline=True)
-def _add_transposed_products(J1, J2, t3, r, scale, H):
-    """H += scale (J1^T (-[r]x) J2 + its transpose): the second variation (dp x dq) . r; t3 (3, 12) scratch."""
-    for k in range(12):
-        q0, q1, q2 = J2[0, k], J2[1, k], J2[2, k]
-        t3[0, k] = r[2] * q1 - r[1] * q2
-        t3[1, k] = r[0] * q2 - r[2] * q0
-        t3[2, k] = r[1] * q0 - r[0] * q1
-    for i in range(12):
-        a0, a1, a2 = J1[0, i], J1[1, i], J1[2, i]
-        if a0 == 0.0 and a1 == 0.0 and a2 == 0.0:
-            continue
-        for k in range(12):
-            v = scale * (a0 * t3[0, k] + a1 * t3[1, k] + a2 * t3[2, k])
-            H[i, k] += v
-            H[k, i] += v
-
-
-@njit(cache=True)
-def hinge_angle_into(p, want_gradient, want_hessian, grad, hess, Ja, Jb, HX, HT, t3, dX, dT, dl, dY, vec):
-    """hinge_angle with the caller's scratch arrays (allocated once per assembly, not per hinge)."""
-    e0, e1, e2 = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
-    w0, w1, w2 = p[2, 0] - p[0, 0], p[2, 1] - p[0, 1], p[2, 2] - p[0, 2]
-    ua, ub, e, ubxua, uaxe, exub = vec[0], vec[1], vec[2], vec[3], vec[4], vec[5]
-    ua[0], ua[1], ua[2] = e1 * w2 - e2 * w1, e2 * w0 - e0 * w2, e0 * w1 - e1 * w0
-    f0, f1, f2 = -e0, -e1, -e2
-    w0, w1, w2 = p[3, 0] - p[1, 0], p[3, 1] - p[1, 1], p[3, 2] - p[1, 2]
-    ub[0], ub[1], ub[2] = f1 * w2 - f2 * w1, f2 * w0 - f0 * w2, f0 * w1 - f1 * w0
-    e[0], e[1], e[2] = e0, e1, e2
-    length = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-    X = ua[0] * ub[0] + ua[1] * ub[1] + ua[2] * ub[2]
-    _cross(ub, ua, ubxua)
-    T = ubxua[0] * e0 + ubxua[1] * e1 + ubxua[2] * e2
-    Y = T / length
-    psi = math.atan2(Y, X)
+    edge, wing, S, N = np.empty(4), np.empty((2, 8)), np.empty((3, 3)), np.empty((3, 3))
+    psi = _hinge_frame(p, 0, 1, 2, 3, edge, wing)
     if not want_gradient:
         return psi
-    _normal_jacobian(p, _SLOTS_A, Ja)
-    _normal_jacobian(p, _SLOTS_B, Jb)
-    _cross(ua, e, uaxe)
-    _cross(e, ub, exub)
-    # Je = [-I, I, 0, 0] (e = v1 - v0) is applied by hand below
-    for i in range(12):
-        dX[i] = Ja[0, i] * ub[0] + Ja[1, i] * ub[1] + Ja[2, i] * ub[2] \
-            + Jb[0, i] * ua[0] + Jb[1, i] * ua[1] + Jb[2, i] * ua[2]
-        dT[i] = Jb[0, i] * uaxe[0] + Jb[1, i] * uaxe[1] + Jb[2, i] * uaxe[2] \
-            + Ja[0, i] * exub[0] + Ja[1, i] * exub[1] + Ja[2, i] * exub[2]
-        dl[i] = 0.0
-    for k in range(3):
-        dT[k] -= ubxua[k]
-        dT[3 + k] += ubxua[k]
-        dl[k] = -e[k] / length
-        dl[3 + k] = e[k] / length
-    R2 = X * X + Y * Y
-    for i in range(12):
-        dY[i] = dT[i] / length - T * dl[i] / (length * length)
-        grad[i] = (X * dY[i] - Y * dX[i]) / R2
+    grad[:] = 0.0
+    for w in range(2):
+        g0, g1, g2 = _wing_gradient(wing, w)
+        xi = wing[w, 7]
+        for k, gk in enumerate((g0, g1, g2)):
+            grad[6 + 3 * w + k] = gk
+            grad[3 + k] -= xi * gk
+            grad[k] -= (1.0 - xi) * gk
     if not want_hessian:
         return psi
-    HX[:, :] = 0.0
-    _add_bilinear(_SLOTS_A, ub, 1.0, HX)
-    _add_bilinear(_SLOTS_B, ua, 1.0, HX)
-    for i in range(12):
-        for k in range(12):
-            v = Ja[0, i] * Jb[0, k] + Ja[1, i] * Jb[1, k] + Ja[2, i] * Jb[2, k]
-            HX[i, k] += v
-            HX[k, i] += v
-    HT[:, :] = 0.0
-    _add_bilinear(_SLOTS_B, uaxe, 1.0, HT)
-    _add_bilinear(_SLOTS_A, exub, 1.0, HT)
-    _add_transposed_products(Jb, Ja, t3, e, 1.0, HT)
-    # the pairs with de: (du_a x de) . u_b and (de x du_b) . u_a, de = dv1 - dv0
-    _add_transposed_products(Ja, _JE, t3, ub, 1.0, HT)
-    _add_transposed_products(_JE, Jb, t3, ua, 1.0, HT)
-    inv_l = 1.0 / length
-    inv_l2 = inv_l * inv_l
-    inv_l3 = inv_l2 * inv_l
-    inv_r2 = 1.0 / R2
-    inv_r4 = inv_r2 * inv_r2
-    # per-index factors hoisted out of the 12 x 12 loop (t3 is free scratch here):
-    # t3[0] = g = X dY - Y dX, t3[1] = 2 X dX + 2 Y dY
-    for i in range(12):
-        t3[0, i] = X * dY[i] - Y * dX[i]
-        t3[1, i] = 2.0 * X * dX[i] + 2.0 * Y * dY[i]
-    for i in range(12):
-        gi, ci, dTi, dli = t3[0, i], t3[1, i], dT[i], dl[i]
-        for k in range(i, 12):
-            # Hessian of l = |e|: Je^T (I - e e^T / l^2) Je / l, nonzero on the (v0, v1) blocks
-            hl = 0.0
-            if i < 6 and k < 6:
-                a, b = i % 3, k % 3
-                sign = (1.0 if (i < 3) == (k < 3) else -1.0)
-                hl = sign * ((1.0 if a == b else 0.0) - e[a] * e[b] * inv_l2) * inv_l
-            hy = (HT[i, k] * inv_l - (dTi * dl[k] + dli * dT[k]) * inv_l2 - T * hl * inv_l2
-                  + 2.0 * T * dli * dl[k] * inv_l3)
-            # the antisymmetric terms dY_i dX_k - dX_i dY_k cancel in the symmetrised sum
-            common = (X * hy - Y * HX[i, k]) * inv_r2
-            v = common - 0.5 * (gi * t3[1, k] + t3[0, k] * ci) * inv_r4
-            hess[i, k] = v
-            hess[k, i] = v
+    hess[:, :] = 0.0
+    for w in range(2):
+        _add_wing_hessian(edge, wing, w, 1.0, (0, 3, 6 + 3 * w), hess, S, N)
+    for r in range(12):
+        for c in range(r):
+            hess[c, r] = hess[r, c]
     return psi
 
 
 # ---------------------------------------------------------------------------- assembly
+@njit(cache=True, forceinline=True)
+def _lower_jkj(K, f, J, KJ, block, m):
+    """block[r, c] = (J^T K_f J)[r, c] for c <= r < m (KJ (3, m) scratch)."""
+    for i in range(3):
+        k0, k1, k2 = K[f, i, 0], K[f, i, 1], K[f, i, 2]
+        for c in range(m):
+            KJ[i, c] = k0 * J[0, c] + k1 * J[1, c] + k2 * J[2, c]
+    for r in range(m):
+        j0, j1, j2 = J[0, r], J[1, r], J[2, r]
+        for c in range(r + 1):
+            block[r, c] = j0 * KJ[0, c] + j1 * KJ[1, c] + j2 * KJ[2, c]
+
+
+@njit(cache=True, forceinline=True)
+def _stencil_dofs(stencil, face_edges, vertex_dof, edge_dof, f, dofs):
+    """The global DOFs of triangle f's stencil in its local numbering (add_midedge_terms); returns
+    their number m."""
+    nv = 3
+    while nv < 6 and stencil[f, nv] >= 0:
+        nv += 1
+    for s in range(nv):
+        b = 3 * s if s < 3 else 3 * s + 3
+        v = stencil[f, s]
+        for k in range(3):
+            dofs[b + k] = vertex_dof[v, k]
+    for i in range(3):
+        dofs[9 + i] = edge_dof[face_edges[f, i]]
+    return 3 * nv + 3
+
+
 @njit(cache=True)
-def add_midedge_terms(x, theta, triangles, face_edges, face_roles, hinge_of_edge, hinges, K,
-                      vertex_dof, edge_dof, n, grad, band, want_gradient, want_hessian):
+def add_midedge_terms(x, theta, stencil, hinge_slots, face_edges, K, vertex_dof, edge_dof, n, grad, band,
+                      want_gradient, want_hessian):
     """Bending energy sum_f 1/2 phi_f^T K_f phi_f of the mid-edge plate; adds its gradient into
     grad (n,) and its Hessian into the lower band (flattened, ddg.assembly.band_scatter).
 
-    x (N, 3) positions, theta (E,) edge angles; face_edges (T, 3) the edge opposite each vertex,
-    face_roles (T, 3) ROLE_FIRST / ROLE_SECOND, hinge_of_edge (E,) the edge's row in hinges (H, 4)
-    = (v0, v1, o_a, o_b) with a its first triangle (-1 for a free edge); K (T, 3, 3);
-    vertex_dof (N, 3) and edge_dof (E,) the global DOF numbers."""
+    x (N, 3) positions, theta (E,) edge angles; stencil (T, 6) each triangle's vertices (its own
+    three, then the far vertices o_a of the edges it is second on, each once; -1 after them);
+    hinge_slots (T, 3, 4) the stencil rows of the hinge (v0, v1, o_a, o_b) of edge i (opposite
+    vertex i) where the triangle is its second triangle b (phi_i = -(theta + psi)), -1 where it is
+    the first (phi_i = theta); face_edges (T, 3); K (T, 3, 3); vertex_dof (N, 3) and edge_dof (E,)
+    the global DOF numbers.
+
+    Local numbering of a triangle's stencil: its own vertices' coordinates 0-8, its three angles
+    9-11, the far vertices' coordinates from 12 on. The Hessian J^T K J - sum_i kphi_i Hess(psi_i),
+    kphi = K phi, is formed on the lower triangle of the local block only and added into the band at
+    |r - c| n + min(r, c), the next triangle's entries prefetched meanwhile (ddg.assembly.band_scatter:
+    the wide stencil's entries are often not yet in cache; the membranes' narrower ones mostly are,
+    and they are not prefetched)."""
     energy = 0.0
-    # stencil: the triangle's 3 vertices, the far vertex o_a of each edge it is second on, 3 thetas
     dofs = np.empty(21, dtype=np.int64)
-    J = np.empty((3, 21))
-    hloc = np.empty((12, 12))
-    gloc = np.empty(12)
-    pts = np.empty((4, 3))
-    slot_of = np.empty(4, dtype=np.int64)
-    block = np.empty((21, 21))
-    gstencil = np.empty(21)
-    phi = np.empty(3)
-    psis_hess = np.empty((3, 12, 12))
-    psis_slots = np.empty((3, 4), dtype=np.int64)
-    Ja, Jb, HX, HT, t3, dX, dT, dl, dY = (np.empty((3, 12)), np.empty((3, 12)), np.empty((12, 12)),
-                                          np.empty((12, 12)), np.empty((3, 12)), np.empty(12), np.empty(12),
-                                          np.empty(12), np.empty(12))
-    kphi = np.empty(3)
+    J = np.zeros((3, 21))
     KJ = np.empty((3, 21))
-    vec = np.empty((6, 3))
-    for f in range(triangles.shape[0]):
-        m = 0
-        for a in range(3):
+    block = np.empty((21, 21))
+    P = np.empty((6, 3))
+    base = np.empty(6, dtype=np.int64)
+    phi = np.empty(3)
+    kphi = np.empty(3)
+    edges = np.empty((3, 4))
+    wings = np.empty((3, 2, 8))
+    S = np.empty((3, 3))
+    N = np.empty((3, 3))
+    ahead = np.empty(21, dtype=np.int64)
+    for f in range(stencil.shape[0]):
+        if want_hessian and f + 1 < stencil.shape[0]:
+            prefetch_lower(band, n, ahead, _stencil_dofs(stencil, face_edges, vertex_dof, edge_dof, f + 1, ahead))
+        m = _stencil_dofs(stencil, face_edges, vertex_dof, edge_dof, f, dofs)
+        nv = m // 3 - 1
+        for s in range(nv):
+            v = stencil[f, s]
+            base[s] = 3 * s if s < 3 else 3 * s + 3
             for k in range(3):
-                dofs[m] = vertex_dof[triangles[f, a], k]
-                m += 1
-        J[:, :] = 0.0
-        for i in range(3):  # stencil slots 9, 10, 11: the thetas
+                P[s, k] = x[v, k]
+        for i in range(3):
             e = face_edges[f, i]
-            dofs[9 + i] = edge_dof[e]
-            if face_roles[f, i] == ROLE_FIRST:
+            if hinge_slots[f, i, 0] < 0:
                 phi[i] = theta[e]
                 J[i, 9 + i] = 1.0
-            else:
-                J[i, 9 + i] = -1.0
-        m = 12
-        for i in range(3):
-            if face_roles[f, i] != ROLE_SECOND:
                 continue
-            e = face_edges[f, i]
-            h = hinge_of_edge[e]
-            for s in range(4):
-                v = hinges[h, s]
-                for k in range(3):
-                    pts[s, k] = x[v, k]
-                # the hinge's vertices in the stencil: own vertices first, o_a appended
-                found = -1
-                for a in range(3):
-                    if triangles[f, a] == v:
-                        found = 3 * a
-                if found < 0:
-                    found = m
-                    for k in range(3):
-                        dofs[m + k] = vertex_dof[v, k]
-                    m += 3
-                slot_of[s] = found
-            psi = hinge_angle_into(pts, want_gradient, want_hessian, gloc, hloc, Ja, Jb, HX, HT, t3, dX, dT, dl, dY,
-                                   vec)
+            s0, s1, sa, sb = hinge_slots[f, i, 0], hinge_slots[f, i, 1], hinge_slots[f, i, 2], hinge_slots[f, i, 3]
+            psi = _hinge_frame(P, s0, s1, sa, sb, edges[i], wings[i])
             phi[i] = -(theta[e] + psi)
-            if want_gradient:
-                for s in range(4):
-                    for k in range(3):
-                        J[i, slot_of[s] + k] -= gloc[3 * s + k]
-            if want_hessian:
-                psis_hess[i] = hloc
-                for s in range(4):
-                    psis_slots[i, s] = slot_of[s]
+            if not want_gradient:
+                continue
+            J[i, 9 + i] = -1.0
+            # d phi_i = -d psi_i
+            b0, b1 = base[s0], base[s1]
+            for w in range(2):
+                g0, g1, g2 = _wing_gradient(wings[i], w)
+                xi = wings[i, w, 7]
+                bo = base[sa] if w == 0 else base[sb]
+                J[i, bo] -= g0
+                J[i, bo + 1] -= g1
+                J[i, bo + 2] -= g2
+                J[i, b1] += xi * g0
+                J[i, b1 + 1] += xi * g1
+                J[i, b1 + 2] += xi * g2
+                J[i, b0] += (1.0 - xi) * g0
+                J[i, b0 + 1] += (1.0 - xi) * g1
+                J[i, b0 + 2] += (1.0 - xi) * g2
         for i in range(3):
             kphi[i] = K[f, i, 0] * phi[0] + K[f, i, 1] * phi[1] + K[f, i, 2] * phi[2]
         energy += 0.5 * (phi[0] * kphi[0] + phi[1] * kphi[1] + phi[2] * kphi[2])
         if not want_gradient:
             continue
         for c in range(m):
-            gstencil[c] = J[0, c] * kphi[0] + J[1, c] * kphi[1] + J[2, c] * kphi[2]
-            grad[dofs[c]] += gstencil[c]
-        if not want_hessian:
-            continue
+            grad[dofs[c]] += J[0, c] * kphi[0] + J[1, c] * kphi[1] + J[2, c] * kphi[2]
+        if want_hessian:
+            # m = 12 + 3 (far vertices): each size compiled with its loop bounds known
+            if m == 21:
+                _lower_jkj(K, f, J, KJ, block, 21)
+            elif m == 18:
+                _lower_jkj(K, f, J, KJ, block, 18)
+            elif m == 15:
+                _lower_jkj(K, f, J, KJ, block, 15)
+            else:
+                _lower_jkj(K, f, J, KJ, block, 12)
+            for i in range(3):
+                if hinge_slots[f, i, 0] < 0:
+                    continue
+                # d2 phi_i = -d2 psi_i
+                r0, r1 = base[hinge_slots[f, i, 0]], base[hinge_slots[f, i, 1]]
+                _add_wing_hessian(edges[i], wings[i], 0, -kphi[i], (r0, r1, base[hinge_slots[f, i, 2]]), block, S, N)
+                _add_wing_hessian(edges[i], wings[i], 1, -kphi[i], (r0, r1, base[hinge_slots[f, i, 3]]), block, S, N)
+            for r in range(m):
+                dr = dofs[r]
+                for c in range(r + 1):
+                    dc = dofs[c]
+                    band[abs(dr - dc) * n + min(dr, dc)] += block[r, c]
         for i in range(3):
             for c in range(m):
-                KJ[i, c] = K[f, i, 0] * J[0, c] + K[f, i, 1] * J[1, c] + K[f, i, 2] * J[2, c]
-        for r in range(m):
-            for c in range(m):
-                block[r, c] = J[0, r] * KJ[0, c] + J[1, r] * KJ[1, c] + J[2, r] * KJ[2, c]
-        for i in range(3):
-            if face_roles[f, i] != ROLE_SECOND:
-                continue
-            # d2 phi_i = -d2 psi_i
-            for s in range(4):
-                for t in range(4):
-                    rs, ct = psis_slots[i, s], psis_slots[i, t]
-                    for k in range(3):
-                        for c in range(3):
-                            block[rs + k, ct + c] -= kphi[i] * psis_hess[i, 3 * s + k, 3 * t + c]
-        add_symmetric_block(band, n, dofs[:m], block[:m, :m])
+                J[i, c] = 0.0
     return energy
-

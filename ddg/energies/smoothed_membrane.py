@@ -32,8 +32,6 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ..assembly.band_scatter import add_symmetric_block
-
 _S = np.array([[[1.0, 0.0], [0.0, 0.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0, 0.0], [0.0, 1.0]]])
 
 
@@ -51,20 +49,35 @@ def strain_maps(nodes: np.ndarray, triangles: np.ndarray) -> tuple[np.ndarray, n
 
 
 def node_patches(triangles: np.ndarray, area: np.ndarray, active: np.ndarray | None = None):
-    """Node patches of the `active` triangles (default all): (pointer (P + 1,), patch triangles,
-    weights w_Pf, patch areas A_P), one patch per node that an active triangle touches."""
+    """Node patches of the `active` triangles (default all), one per node that an active triangle
+    touches: (pointer (P + 1,), patch triangles, weights w_Pf, patch areas A_P, node_pointer (P + 1,),
+    patch nodes (each patch's nodes, its own first), face slots (per patch triangle, the rows of
+    its three vertices in its patch's nodes))."""
     active = np.ones(len(triangles), dtype=bool) if active is None else np.asarray(active, dtype=bool)
     faces = np.flatnonzero(active)
     node = triangles[faces].ravel()
     face = np.repeat(faces, 3)
     order = np.argsort(node, kind="stable")
     node, face = node[order], face[order]
-    _, start = np.unique(node, return_index=True)
+    centres, start = np.unique(node, return_index=True)
     pointer = np.r_[start, len(node)].astype(np.int64)
     share = area[face] / 3.0
     patch_area = np.add.reduceat(share, start)
     weights = share / np.repeat(patch_area, np.diff(pointer))
-    return pointer, face.astype(np.int64), weights, patch_area
+    node_pointer = [0]
+    patch_nodes, face_slots = [], np.empty((len(face), 3), dtype=np.int64)
+    for P, centre in enumerate(centres):
+        members = [int(centre)]
+        for m in range(pointer[P], pointer[P + 1]):
+            for v in range(3):
+                vertex = int(triangles[face[m], v])
+                if vertex not in members:
+                    members.append(vertex)
+                face_slots[m, v] = members.index(vertex)
+        patch_nodes += members
+        node_pointer.append(len(patch_nodes))
+    return (pointer, face.astype(np.int64), weights, patch_area, np.array(node_pointer, dtype=np.int64),
+            np.array(patch_nodes, dtype=np.int64), face_slots)
 
 
 def plane_stress_matrix(young_modulus: float, thickness: float, poisson_ratio: float) -> np.ndarray:
@@ -74,104 +87,108 @@ def plane_stress_matrix(young_modulus: float, thickness: float, poisson_ratio: f
                                                                     [nu, 0.0, 1.0]])
 
 
+@njit(cache=True, forceinline=True)
+def _lower_gcg(A, C, G, CG, block, nl):
+    """block[r, c] = A (G^T C G)[r, c] for c <= r < nl (CG (3, nl) scratch)."""
+    for a in range(3):
+        ca0, ca1, ca2 = A * C[a, 0], A * C[a, 1], A * C[a, 2]
+        for c in range(nl):
+            CG[a, c] = ca0 * G[0, c] + ca1 * G[1, c] + ca2 * G[2, c]
+    for r in range(nl):
+        g0, g1, g2 = G[0, r], G[1, r], G[2, r]
+        for c in range(r + 1):
+            block[r, c] = g0 * CG[0, c] + g1 * CG[1, c] + g2 * CG[2, c]
+
+
 @njit(cache=True)
-def add_smoothed_membrane_terms(x, triangles, T, abar, pointer, patch_faces, weights, patch_area, C, scale,
-                                vertex_dof, n, grad, band, want_gradient, want_hessian):
+def add_smoothed_membrane_terms(x, triangles, T, abar, pointer, patch_faces, weights, patch_area, node_pointer,
+                                patch_nodes, face_slots, C, scale, vertex_dof, n, grad, band, want_gradient,
+                                want_hessian):
     """scale * sum_P A_P W(eps_P); adds scale times its gradient into grad (n,) and its Hessian
-    into the flattened lower band (ddg.assembly.band_scatter). vertex_dof (N, 3)."""
+    into the flattened lower band (ddg.assembly.band_scatter). The patches as `node_patches` gives
+    them; vertex_dof (N, 3).
+
+    A patch's local DOFs are its nodes' coordinates (3 per node, in patch_nodes' order); its
+    Hessian is formed on the lower triangle of the local block only and added into the band at
+    |r - c| n + min(r, c)."""
     energy = 0.0
-    max_faces = 0
-    for P in range(pointer.shape[0] - 1):
-        max_faces = max(max_faces, pointer[P + 1] - pointer[P])
-    width = 3 * (2 * max_faces + 1)
-    local_nodes = np.empty(2 * max_faces + 1, dtype=np.int64)
-    slot = np.empty((max_faces, 3), dtype=np.int64)
-    deltas = np.empty((max_faces, 3))
-    J = np.empty((max_faces, 3, 9))
-    G = np.empty((3, width))
+    max_nodes = 0
+    for P in range(node_pointer.shape[0] - 1):
+        max_nodes = max(max_nodes, node_pointer[P + 1] - node_pointer[P])
+    width = 3 * max_nodes
+    G = np.zeros((3, width))
+    CG = np.empty((3, width))
+    dofs = np.empty(width, dtype=np.int64)
+    block = np.empty((width, width))
     eps = np.empty(3)
     s = np.empty(3)
-    u = np.empty(3)
-    dofs = np.empty(width, dtype=np.int64)
-    CG = np.empty((3, width))
-    block = np.empty((width, width))
     for P in range(pointer.shape[0] - 1):
         first, last = pointer[P], pointer[P + 1]
-        count = 0
-        eps[:] = 0.0
-        for m in range(last - first):
-            f = patch_faces[first + m]
-            for v in range(3):
-                node = triangles[f, v]
-                k = 0
-                while k < count and local_nodes[k] != node:
-                    k += 1
-                if k == count:
-                    local_nodes[count] = node
-                    count += 1
-                slot[m, v] = k
+        eps[0], eps[1], eps[2] = 0.0, 0.0, 0.0
+        for m in range(first, last):
+            f = patch_faces[m]
             p0, p1, p2 = triangles[f, 0], triangles[f, 1], triangles[f, 2]
-            e1 = x[p1] - x[p0]
-            e2 = x[p2] - x[p0]
-            deltas[m, 0] = e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2] - abar[f, 0]
-            deltas[m, 1] = e1[0] * e2[0] + e1[1] * e2[1] + e1[2] * e2[2] - abar[f, 1]
-            deltas[m, 2] = e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2] - abar[f, 2]
-            w = weights[first + m]
+            a0, a1, a2 = x[p1, 0] - x[p0, 0], x[p1, 1] - x[p0, 1], x[p1, 2] - x[p0, 2]
+            b0, b1, b2 = x[p2, 0] - x[p0, 0], x[p2, 1] - x[p0, 1], x[p2, 2] - x[p0, 2]
+            d0 = a0 * a0 + a1 * a1 + a2 * a2 - abar[f, 0]
+            d1 = a0 * b0 + a1 * b1 + a2 * b2 - abar[f, 1]
+            d2 = b0 * b0 + b1 * b1 + b2 * b2 - abar[f, 2]
+            w = weights[m]
             for a in range(3):
-                eps[a] += w * (T[f, a, 0] * deltas[m, 0] + T[f, a, 1] * deltas[m, 1] + T[f, a, 2] * deltas[m, 2])
+                eps[a] += w * (T[f, a, 0] * d0 + T[f, a, 1] * d1 + T[f, a, 2] * d2)
             if want_gradient:
-                for k in range(3):
-                    J[m, 0, k], J[m, 0, 3 + k], J[m, 0, 6 + k] = -2.0 * e1[k], 2.0 * e1[k], 0.0
-                    J[m, 1, k], J[m, 1, 3 + k], J[m, 1, 6 + k] = -(e1[k] + e2[k]), e2[k], e1[k]
-                    J[m, 2, k], J[m, 2, 3 + k], J[m, 2, 6 + k] = -2.0 * e2[k], 0.0, 2.0 * e2[k]
-        A = patch_area[P]
+                # G = d eps_P / dq: w T_f J_f, J_f the rows d a11 = 2 e1 . d e1, d a12 = e1 . d e2 + e2 . d e1,
+                # d a22 = 2 e2 . d e2 (e1 = p1 - p0, e2 = p2 - p0)
+                i0, i1, i2 = 3 * face_slots[m, 0], 3 * face_slots[m, 1], 3 * face_slots[m, 2]
+                for a in range(3):
+                    t0, t1, t2 = w * T[f, a, 0], w * T[f, a, 1], w * T[f, a, 2]
+                    for k, ek, fk in ((0, a0, b0), (1, a1, b1), (2, a2, b2)):
+                        u1 = 2.0 * t0 * ek + t1 * fk
+                        u2 = t1 * ek + 2.0 * t2 * fk
+                        G[a, i1 + k] += u1
+                        G[a, i2 + k] += u2
+                        G[a, i0 + k] -= u1 + u2
+        A = scale * patch_area[P]
         for a in range(3):
             s[a] = A * (C[a, 0] * eps[0] + C[a, 1] * eps[1] + C[a, 2] * eps[2])
         energy += 0.5 * (s[0] * eps[0] + s[1] * eps[1] + s[2] * eps[2])
         if not want_gradient:
             continue
-        nl = 3 * count
-        G[:, :nl] = 0.0
-        for m in range(last - first):
-            f = patch_faces[first + m]
-            w = weights[first + m]
-            for a in range(3):
-                for c in range(9):
-                    col = 3 * slot[m, c // 3] + c % 3
-                    G[a, col] += w * (T[f, a, 0] * J[m, 0, c] + T[f, a, 1] * J[m, 1, c] + T[f, a, 2] * J[m, 2, c])
-        for i in range(count):
+        nodes = node_pointer[P]
+        nl = 3 * (node_pointer[P + 1] - nodes)
+        for i in range(nl // 3):
+            node = patch_nodes[nodes + i]
             for k in range(3):
-                dofs[3 * i + k] = vertex_dof[local_nodes[i], k]
+                dofs[3 * i + k] = vertex_dof[node, k]
         for c in range(nl):
-            grad[dofs[c]] += scale * (G[0, c] * s[0] + G[1, c] * s[1] + G[2, c] * s[2])
-        if not want_hessian:
-            continue
+            grad[dofs[c]] += G[0, c] * s[0] + G[1, c] * s[1] + G[2, c] * s[2]
+        if want_hessian:
+            if nl == 21:  # an interior patch of 6 triangles: compiled with its loop bounds known
+                _lower_gcg(A, C, G, CG, block, 21)
+            else:
+                _lower_gcg(A, C, G, CG, block, nl)
+            for m in range(first, last):
+                f = patch_faces[m]
+                w = weights[m]
+                # constant Hessians of delta (a11 on p0, p1; a12; a22 on p0, p2), times u = w T_f^T s
+                u0 = w * (T[f, 0, 0] * s[0] + T[f, 1, 0] * s[1] + T[f, 2, 0] * s[2])
+                u1 = w * (T[f, 0, 1] * s[0] + T[f, 1, 1] * s[1] + T[f, 2, 1] * s[2])
+                u2 = w * (T[f, 0, 2] * s[0] + T[f, 1, 2] * s[1] + T[f, 2, 2] * s[2])
+                s11, s12, s22 = 2.0 * u0, u1, 2.0 * u2
+                i0, i1, i2 = 3 * face_slots[m, 0], 3 * face_slots[m, 1], 3 * face_slots[m, 2]
+                for k in range(3):
+                    block[i0 + k, i0 + k] += s11 + 2.0 * s12 + s22
+                    block[i1 + k, i1 + k] += s11
+                    block[i2 + k, i2 + k] += s22
+                    block[max(i0, i1) + k, min(i0, i1) + k] -= s11 + s12
+                    block[max(i0, i2) + k, min(i0, i2) + k] -= s22 + s12
+                    block[max(i1, i2) + k, min(i1, i2) + k] += s12
+            for r in range(nl):
+                dr = dofs[r]
+                for c in range(r + 1):
+                    dc = dofs[c]
+                    band[abs(dr - dc) * n + min(dr, dc)] += block[r, c]
         for a in range(3):
             for c in range(nl):
-                CG[a, c] = C[a, 0] * G[0, c] + C[a, 1] * G[1, c] + C[a, 2] * G[2, c]
-        for r in range(nl):
-            for c in range(nl):
-                block[r, c] = A * (G[0, r] * CG[0, c] + G[1, r] * CG[1, c] + G[2, r] * CG[2, c])
-        for m in range(last - first):
-            f = patch_faces[first + m]
-            w = weights[first + m]
-            for k in range(3):
-                u[k] = w * (T[f, 0, k] * s[0] + T[f, 1, k] * s[1] + T[f, 2, k] * s[2])
-            # constant Hessians of delta (a11 on p0, p1; a12; a22 on p0, p2), times u_k
-            s11, s12, s22 = 2.0 * u[0], u[1], 2.0 * u[2]
-            i0, i1, i2 = 3 * slot[m, 0], 3 * slot[m, 1], 3 * slot[m, 2]
-            for k in range(3):
-                block[i0 + k, i0 + k] += s11 + 2.0 * s12 + s22
-                block[i1 + k, i1 + k] += s11
-                block[i2 + k, i2 + k] += s22
-                block[i0 + k, i1 + k] -= s11 + s12
-                block[i1 + k, i0 + k] -= s11 + s12
-                block[i0 + k, i2 + k] -= s22 + s12
-                block[i2 + k, i0 + k] -= s22 + s12
-                block[i1 + k, i2 + k] += s12
-                block[i2 + k, i1 + k] += s12
-        for r in range(nl):
-            for c in range(nl):
-                block[r, c] *= scale
-        add_symmetric_block(band, n, dofs[:nl], block[:nl, :nl])
-    return scale * energy
+                G[a, c] = 0.0
+    return energy

@@ -47,6 +47,36 @@ from .names import MIDEDGE_PLATE
 MEMBRANES = ("psri", "full")
 
 
+def _bending_stencils(triangles, face_edges, roles, hinge_of_edge, hinges):
+    """Each triangle's bending stencil for ddg.energies.midedge_bending.add_midedge_terms: (stencil
+    (T, 6): its vertices, then the far vertices o_a of the hinges it is second on, each once, -1
+    after them; hinge_slots (T, 3, 4): the stencil rows of (v0, v1, o_a, o_b) of the hinge of edge
+    i where the triangle is the hinge's second triangle b = (v1, v0, o_b), -1 where it is first)."""
+    count = len(triangles)
+    second = roles == ROLE_SECOND
+    rows = hinges[np.maximum(hinge_of_edge[face_edges], 0)]  # (T, 3, 4)
+    stencil = np.full((count, 6), -1, dtype=np.int64)
+    stencil[:, :3] = triangles
+    slots = np.full((count, 3, 4), -1, dtype=np.int64)
+    size = np.full(count, 3)
+    for i in range(3):
+        on = second[:, i]
+        far, v0 = rows[:, i, 2], rows[:, i, 0]
+        if (on & (rows[:, i, 3] != triangles[:, i])).any():
+            raise InputError("a hinge's second triangle is not opposite its own vertex o_b")
+        slot = size.copy()
+        for j in range(i):
+            same = on & second[:, j] & (far == rows[:, j, 2])
+            slot[same] = slots[same, j, 2]
+        new = on & (slot == size)
+        stencil[new, size[new]] = far[new]
+        size += new
+        after, before = (i + 1) % 3, (i + 2) % 3
+        slot_v0 = np.where(triangles[:, after] == v0, after, before)
+        slots[on, i] = np.stack([slot_v0, after + before - slot_v0, slot, np.full(count, i)], axis=1)[on]
+    return np.ascontiguousarray(stencil), np.ascontiguousarray(slots)
+
+
 class MidedgePlateModel(PlateModel):
     """The mid-edge plate of a Strip on a ghost-clamp structured mesh of ~`triangles` triangles
     (or `rows` rows across W, or a given ghost_clamp_mesh). membrane_alpha (with "psri"): the
@@ -127,12 +157,19 @@ class MidedgePlateModel(PlateModel):
         self.membrane_alpha = min(1.0, (b / self._typical_spacing()) ** 2) if membrane == "psri" else 1.0
         if membrane_alpha is not None:  # a fixed share, the same on every mesh (mesh studies)
             self.membrane_alpha = float(membrane_alpha)
-        self._membrane_share = self.membrane_alpha * self._membrane
         self._triangles = np.ascontiguousarray(tris, dtype=np.int64)
         self._face_edges = np.ascontiguousarray(face_edges, dtype=np.int64)
-        self._roles = np.ascontiguousarray(roles, dtype=np.int64)
-        self._hinges = np.ascontiguousarray(hinges, dtype=np.int64)
-        self._hinge_of_edge = hinge_of_edge
+        #: the hinges (v0, v1, o_a, o_b) with a their first triangle, and each edge's row in them (-1: free edge)
+        self._hinges, self._hinge_of_edge = np.ascontiguousarray(hinges, dtype=np.int64), hinge_of_edge
+        self._stencil, self._hinge_slots = _bending_stencils(tris, face_edges, roles, hinge_of_edge, hinges)
+        # the per-triangle passes visit the triangles by their lowest DOF, so that the band entries
+        # they add into stay in a window of the band's columns (the mesh numbers them row by row)
+        lowest = np.where(self._stencil >= 0, self.node_dofs[np.maximum(self._stencil, 0), 0], self.n_dof).min(axis=1)
+        by_x = np.argsort(lowest, kind="stable")
+        self._by_x = {name: np.ascontiguousarray(array[by_x]) for name, array in (
+            ("triangles", self._triangles), ("membrane", self.membrane_alpha * self._membrane),
+            ("abar", self._abar), ("stencil", self._stencil), ("hinge_slots", self._hinge_slots),
+            ("face_edges", self._face_edges), ("bending", self._bending))}
         self._node_dofs = np.ascontiguousarray(self.node_dofs, dtype=np.int64)
         self._edge_dofs = np.ascontiguousarray(self.edge_dofs, dtype=np.int64)
 
@@ -163,15 +200,15 @@ class MidedgePlateModel(PlateModel):
         n = self.n_dof
         grad, band = self._accumulators(gradient, hessian)
         alpha = self.membrane_alpha
-        stretching = add_membrane_terms(x, self._triangles, self._membrane_share, self._abar, self._node_dofs, n,
+        t = self._by_x
+        stretching = add_membrane_terms(x, t["triangles"], t["membrane"], t["abar"], self._node_dofs, n,
                                         grad, band, gradient, hessian)
         if alpha < 1.0:
             stretching += add_smoothed_membrane_terms(x, self._triangles, self._strain_T, self._abar, *self._patches,
                                                       self._plane_stress, 1.0 - alpha, self._node_dofs, n,
                                                       grad, band, gradient, hessian)
-        bending = add_midedge_terms(x, theta, self._triangles, self._face_edges, self._roles, self._hinge_of_edge,
-                                    self._hinges, self._bending, self._node_dofs, self._edge_dofs, n,
-                                    grad, band, gradient, hessian)
+        bending = add_midedge_terms(x, theta, t["stencil"], t["hinge_slots"], t["face_edges"], t["bending"],
+                                    self._node_dofs, self._edge_dofs, n, grad, band, gradient, hessian)
         parts = {"stretching": float(stretching), "bending": float(bending)}
         return self._evaluation(parts, grad, band, gradient, hessian)
 

@@ -62,13 +62,19 @@ class Run:
 #: The studies, fixed before their runs: the default meshes; across W and along L apart (the
 #: columns at 12 rows doubled and tripled, the rows at 84 columns doubled, 8 rows at 168 columns);
 #: rows graded (g = 0.5); alpha fixed at 0 (the node-smoothed membrane alone); at W/L = 1/2 the
-#: default meshes and the columns at 16 and 24 rows doubled and tripled.
+#: default meshes and the columns at 16 and 24 rows doubled and tripled. Added after the first runs:
+#: the clamp columns x = 0, L are regular node columns when n / 2 is even and shifted ones (half rows
+#: at the free edges) when it is odd (ghost_clamp_mesh) - the default meshes of 8, 12, 18 rows have
+#: regular ones, of 16, 20, 24, 28 rows shifted ones; 16 and 20 rows with 112 and 140 columns
+#: (regular) against their defaults 110 and 138 separate that from the column count; at W/L = 1/2,
+#: 32 rows with 76 columns (regular) against the default 74 (shifted).
 RUNS = ([Run(1 / 6, r) for r in (8, 12, 16, 18, 20, 24, 28)]
         + [Run(1 / 6, 12, 168), Run(1 / 6, 12, 252), Run(1 / 6, 24, 84), Run(1 / 6, 8, 168)]
+        + [Run(1 / 6, 16, 112), Run(1 / 6, 20, 140)]
         + [Run(1 / 6, r, grading=0.5) for r in (8, 12, 16, 18, 24)]
         + [Run(1 / 6, r, membrane_alpha=0.0) for r in (8, 12, 16, 24)]
         + [Run(1 / 2, r) for r in (16, 24, 32, 36, 48)]
-        + [Run(1 / 2, 16, 72), Run(1 / 2, 16, 108), Run(1 / 2, 24, 112)])
+        + [Run(1 / 2, 16, 72), Run(1 / 2, 16, 108), Run(1 / 2, 24, 112), Run(1 / 2, 32, 76)])
 
 COLUMNS = ["name", "width_ratio", "rows", "columns", "grading", "membrane_alpha", "triangles", "free_dof",
            "status", "dW1_over_L", "newton_iterations", "wall_time_s"]
@@ -167,6 +173,8 @@ def report(rows: list[dict]) -> str:
                  ("W/L = 1/6, graded, rows 12/18/24", ["W6_R12_g0.5", "W6_R18_g0.5", "W6_R24_g0.5"], "rows"),
                  ("W/L = 1/2, default meshes 16/24/36", ["W2_R16", "W2_R24", "W2_R36"], "rows"),
                  ("W/L = 1/2, default meshes 24/36/48", ["W2_R24", "W2_R36", "W2_R48"], "rows"),
+                 ("W/L = 1/2, default meshes 16/32/48 (shifted clamp columns from 32)", ["W2_R16", "W2_R32", "W2_R48"],
+                  "rows"),
                  ("W/L = 1/2, 16 rows, columns 36/72/108", ["W2_R16", "W2_R16_C72", "W2_R16_C108"], "columns")]
     lines += ["| sequence | dW1/L | differences | observed order |", "|---|---|---|---:|"]
     for label, names, spacing in sequences:
@@ -180,6 +188,25 @@ def report(rows: list[dict]) -> str:
         lines.append(f"| {label} | {' / '.join(f'{v:.5f}' for v in values)} | "
                      f"{values[0] - values[1]:+.5f} / {values[1] - values[2]:+.5f} | "
                      f"{'none' if p is None else f'{p:.2f}'} |")
+    pairs = [("alpha fixed at 0 against b^2 / h^2, 8 rows", "W6_R8_a0", "W6_R8"),
+             ("alpha fixed at 0 against b^2 / h^2, 12 rows", "W6_R12_a0", "W6_R12"),
+             ("alpha fixed at 0 against b^2 / h^2, 16 rows", "W6_R16_a0", "W6_R16"),
+             ("alpha fixed at 0 against b^2 / h^2, 24 rows", "W6_R24_a0", "W6_R24"),
+             ("graded against uniform, 8 rows", "W6_R8_g0.5", "W6_R8"),
+             ("graded against uniform, 12 rows", "W6_R12_g0.5", "W6_R12"),
+             ("graded against uniform, 16 rows", "W6_R16_g0.5", "W6_R16"),
+             ("graded against uniform, 18 rows", "W6_R18_g0.5", "W6_R18"),
+             ("graded against uniform, 24 rows", "W6_R24_g0.5", "W6_R24"),
+             ("regular clamp column (112) against shifted (110), 16 rows", "W6_R16_C112", "W6_R16"),
+             ("regular clamp column (140) against shifted (138), 20 rows", "W6_R20_C140", "W6_R20"),
+             ("W/L = 1/2: regular clamp column (76) against shifted (74), 32 rows", "W2_R32_C76", "W2_R32")]
+    lines += ["", "## Pairs", "", "| change | dW1/L (changed) | dW1/L (default) | difference |", "|---|---:|---:|---:|"]
+    for label, a, b in pairs:
+        va, vb = (_value(by_name[x], "dW1_over_L") if x in by_name else None for x in (a, b))
+        if va is None or vb is None:
+            lines.append(f"| {label} | not all run | | |")
+        else:
+            lines.append(f"| {label} | {va:.6f} | {vb:.6f} | {va - vb:+.6f} |")
     return "\n".join(lines) + "\n"
 
 

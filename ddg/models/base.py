@@ -86,7 +86,7 @@ class BandedModel:
         where not asked)."""
         n = self.n_dof
         if hessian:
-            keep_large_blocks(8 * (self.bandwidth + 1) * n)  # fine plates: no page faults per iteration
+            keep_large_blocks(8 * (self.bandwidth + 1) * n)  # plates: no page faults per iteration
         return (np.zeros(n) if gradient else np.empty(0),
                 np.zeros((self.bandwidth + 1) * n) if hessian else np.empty(0))
 

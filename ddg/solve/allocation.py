@@ -1,17 +1,19 @@
 """Large arrays kept mapped from one Newton iteration to the next (glibc's malloc).
 
-A plate's banded Hessian holds (bandwidth + 1) n doubles; on fine meshes that is tens to hundreds
-of megabytes (the mid-edge plate on 28 rows at W/L = 1/6: 96 MB), and every iteration makes
-several such arrays: the Hessian, its free block, the Cholesky factor's copy. glibc's malloc
-serves a block above its mmap threshold (adjusted at run time, but never above 32 MiB) with fresh
-pages from the kernel, so each of these arrays pays a page fault per 4 KiB page when it is first
-written: zeroing and touching 96 MB took 90 ms, against 6 ms for the same block taken again from
-the heap (docs/findings/measured.md). `keep_large_blocks` raises the mmap and trim thresholds
-so that blocks up to LARGEST_HEAP_BLOCK come from the heap and stay mapped after they are freed:
-the process keeps its peak memory instead of returning it between iterations.
+A plate's banded Hessian holds (bandwidth + 1) n doubles: 8.6 MB on the mid-edge plate's 12 rows
+at W/L = 1/6, 96 MB on 28 rows; and every iteration makes three such arrays (the Hessian, its free
+block, the Cholesky factor's copy) and frees them. glibc serves a block above its mmap threshold
+(self-adjusting, at most 32 MiB) with fresh pages from the kernel, and returns the heap's free top
+to the kernel once it exceeds the trim threshold (twice the mmap one), which three freed
+Hessian-sized blocks do: either way the next iteration's arrays are fresh pages again, and each
+pays a page fault per 4 KiB page when first written (zeroing and touching 96 MB: 90 ms, against 6 ms
+for the same block taken again from the heap; measured in benchmarks/results/plate_iteration.md and
+docs/findings/measured.md). `keep_large_blocks` raises both thresholds to LARGEST_HEAP_BLOCK, so
+that such blocks come from the heap and stay mapped after they are freed: the process keeps its
+peak memory instead of returning it between iterations.
 
-It acts once per process, only under glibc, only when a model asks for a block above glibc's
-own ceiling, and not at all with DDG_MALLOC=default in the environment.
+It acts once per process, only under glibc, only when a model asks for a Hessian above ACT_ABOVE
+bytes, and not at all with DDG_MALLOC=default in the environment.
 """
 from __future__ import annotations
 
@@ -19,8 +21,9 @@ import ctypes
 import os
 import sys
 
-#: glibc's ceiling for its self-adjusting mmap threshold on 64-bit systems (DEFAULT_MMAP_THRESHOLD_MAX)
-GLIBC_DYNAMIC_CEILING = 32 * 1024 * 1024
+#: a Hessian above this makes the process keep large blocks (the rods' and the coarse plates' stay
+#: below it: their arrays are small enough for glibc's own adjustment)
+ACT_ABOVE = 1024 * 1024
 #: blocks up to this size are served from the heap once keep_large_blocks has acted
 LARGEST_HEAP_BLOCK = 1 << 30
 #: mallopt's parameters (malloc.h)
@@ -30,10 +33,10 @@ _state = {"done": False, "active": False}
 
 
 def keep_large_blocks(nbytes: int) -> bool:
-    """Serve blocks of up to LARGEST_HEAP_BLOCK bytes from the heap from now on, if a block of
-    `nbytes` is above glibc's dynamic ceiling (module docstring). Returns whether the thresholds
-    are raised (now or by an earlier call)."""
-    if _state["done"] or nbytes <= GLIBC_DYNAMIC_CEILING:
+    """Serve blocks of up to LARGEST_HEAP_BLOCK bytes from the heap from now on, if a Hessian of
+    `nbytes` is above ACT_ABOVE (module docstring). Returns whether the thresholds are raised (now
+    or by an earlier call)."""
+    if _state["done"] or nbytes <= ACT_ABOVE:
         return _state["active"]
     _state["done"] = True
     if os.environ.get("DDG_MALLOC", "").strip().lower() == "default" or not sys.platform.startswith("linux"):

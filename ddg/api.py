@@ -317,6 +317,24 @@ def simulate(
                        frames=frames, probe=probe, summary_extra=extra, centerline=centerline)
 
 
+def simulate_model(instance, protocol: LoadingProtocol, *, options: ContinuationOptions | None = None,
+                   out: str | Path | None = None, thresholds: bool = True, branches: bool = False,
+                   centerline: bool = True, probe: Probe | None = None) -> SimulationResult:
+    """The two-stage protocol on a model the caller built (a static run, as `simulate`): e.g. a
+    ddg.models.midedge_plate.MidedgePlateModel on a mesh of one's own or with a fixed membrane
+    share (the mesh studies of validation.midedge_convergence). The strip is the model's."""
+    strip = instance.strip
+    _checked_scene(strip, protocol)
+    protocol.resolved_shear_ratio(strip)
+    _checked_flags(thresholds=thresholds, centerline=centerline)
+    if out is not None:
+        from .output.io import check_output_directory
+
+        check_output_directory(out)
+    return _static_run(instance.name, instance, strip, protocol, None, _checked_options(options), out, False,
+                       thresholds, bool(branches), probe=probe, centerline=centerline)
+
+
 def _static_run(name, instance, strip, protocol, resolution, options, out, progress, thresholds, branches,
                 frames=False, summary_extra=None, stepper=None, result=SimulationResult, probe=None,
                 centerline=True):

@@ -96,10 +96,9 @@ def graded(mesh, grading: float):
 def run_one(run: Run) -> dict:
     """dW1 of one run (module docstring)."""
     import ddg
-    from ddg.api import _static_run
+    from ddg.api import simulate_model
     from ddg.geometry.plate_mesh import ghost_clamp_mesh
     from ddg.models.midedge_plate import MidedgePlateModel
-    from ddg.solve.continuation import ContinuationOptions
 
     strip = ddg.Strip.from_ratios(run.width_ratio, COMPRESSION_RATIO)
     mesh = ghost_clamp_mesh(strip.length, strip.width, rows=run.rows, columns=run.columns)
@@ -110,8 +109,7 @@ def run_one(run: Run) -> dict:
     steps = int(round(120 * stop / ddg.LoadingProtocol(COMPRESSION_RATIO).resolved_shear_ratio(strip)))
     protocol = ddg.LoadingProtocol(COMPRESSION_RATIO, stop, shear_steps=steps)
     t0 = time.perf_counter()
-    summary = _static_run("plate-midedge", model, strip, protocol, None, ContinuationOptions(), None, False, True,
-                          False, centerline=False).summary
+    summary = simulate_model(model, protocol, centerline=False).summary
     return {"name": run.name, "width_ratio": run.width_ratio, "rows": run.rows, "columns": run.columns or "",
             "grading": run.grading, "membrane_alpha": model.membrane_alpha, "triangles": mesh.triangle_count,
             "free_dof": model.free.stop - model.free.start, "status": summary["status"],

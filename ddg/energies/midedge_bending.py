@@ -1,58 +1,42 @@
 """Mid-edge bending of a triangle mesh: a discrete Kirchhoff plate with the material's Poisson ratio.
 
-The energy of the second plate model (`plate-midedge`, ddg.models.midedge_plate). The paper's hinge
-energy (Eq. 11b, ddg.energies.hinge_bending) weighs each edge's bending angle with a fixed
-coefficient, which fixes the bending Poisson ratio at -1/3 and misweighs the edge rows of a free
-boundary; this one builds each triangle's second fundamental form from the normals at its three
-edge midpoints and integrates the plate's density with the material's Poisson ratio nu (the mid-edge
-shells of Chen, Weischedel et al. 2018 and libshell; linearised, Morley's nonconforming element).
+The bending of `plate-midedge` (ddg.models.midedge_plate): each triangle's second fundamental form
+from the normals at its three edge midpoints, integrated with the plate's density and Poisson ratio
+nu (the mid-edge shells of Chen, Weischedel et al. 2018 and libshell; linearised, Morley's element),
+where the paper's hinge energy (Eq. 11b, ddg.energies.hinge_bending) fixes the ratio at -1/3.
 
-Mid-edge normals. Each edge e carries one angle DOF theta_e, the tilt of its mid-edge normal
-(the "director", perpendicular to the edge) from the normal of its first triangle a toward a's
-outward in-plane edge normal m_a = e_hat x N_a. A triangle f sees, on each of its edges i, the
-director's tilt phi_i from its own normal toward its own outward edge normal:
-
-  phi = theta_e               on the first triangle a of an edge (and the only one of a free edge),
-  phi = -(theta_e + psi_e)    on the second triangle b,
-
-with psi_e the signed bending angle of the edge's hinge (positive where the surface turns up
-toward N_a, a valley; `hinge_angle`). A free edge's theta is free: the natural boundary
-condition comes out of the minimisation. A clamped edge has a rigid ghost triangle as a
+Mid-edge normals. Each edge e carries one angle DOF theta_e, the tilt of its mid-edge normal from
+the normal of its first triangle a toward a's outward in-plane edge normal m_a = e_hat x N_a. A
+triangle sees on its edge i the tilt phi_i from its own normal toward its own outward edge normal:
+phi = theta_e on the first triangle a of an edge (and the only one of a free edge, whose theta is
+free: the natural boundary condition), phi = -(theta_e + psi_e) on the second triangle b, with psi_e
+the signed bending angle of the edge's hinge (positive where the surface turns up toward N_a, a
+valley; `hinge_angle`). A clamped edge has a rigid ghost triangle as a
 (ddg.geometry.plate_mesh.ghost_clamp_mesh) and theta = 0: the director is the clamp's normal.
 
-Second fundamental form (Morley's exact identity for quadratic surfaces, derived in the
-module's tests): in the basis e1 = p1 - p0, e2 = p2 - p0 of a triangle with its edge i opposite
-vertex i, II = sum_i phi_i (4 A / l_i) d_i d_i^T with d_0 = (-1, -1), d_1 = (1, 0), d_2 = (0, 1).
-A and l_i are taken in the reference state (the strains are ~1e-4 where the plate is thin;
-objectivity is kept, as phi depends on angles only). The bending energy of the triangle is
+Second fundamental form (Morley's exact identity for quadratic surfaces, derived in the tests): in
+the basis e1 = p1 - p0, e2 = p2 - p0, edge i opposite vertex i, II = sum_i phi_i (4 A / l_i) d_i d_i^T
+with d_0 = (-1, -1), d_1 = (1, 0), d_2 = (0, 1); A and l_i in the reference state (strains ~1e-4). Then
 
   E_f = A (D / 2) [nu tr(M)^2 + (1 - nu) tr(M^2)],   M = abar^-1 II,   D = E b^3 / (12 (1 - nu^2)),
 
-the Kirchhoff plate's density for the mixed curvature tensor M, i.e. E_f = 1/2 phi^T K_f phi with
-a constant 3 x 3 K_f per triangle (`face_bending_matrices`). phi is linear in theta and psi, so
-the derivatives need only psi's gradient and Hessian in the hinge's 12 coordinates.
+i.e. E_f = 1/2 phi^T K_f phi with a constant 3 x 3 K_f (`face_bending_matrices`); phi is linear in
+theta and psi, so the derivatives need only psi's gradient and Hessian in the hinge's 12 coordinates.
 
-The hinge angle. With e = v1 - v0 (length l, unit e_hat), the unnormalised normals
-u_a = e x (o_a - v0) of a = (v0, v1, o_a) and u_b = (v0 - v1) x (o_b - v1) of b = (v1, v0, o_b):
-
-  psi = atan2(Y, X),  X = u_a . u_b,  Y = (u_b x u_a) . e / l.
-
-Its derivatives in closed form (as Bridson et al. 2003 and Tamstorf & Grinspun 2013 write them),
-per wing w = a, b of the hinge with its far vertex o_w: q_w = e x (o_w - v0) (= u_a, = -u_b),
-n = q_w / |q_w|, t = e_hat x n, h = |q_w| / l the height of o_w over the edge, xi = (o_w - v0) . e / l^2
-the foot of that height along the edge, and s = +1 on a, -1 on b. psi turns with the wings about
-the edge, so
+The hinge angle. e = v1 - v0 (length l, unit e_hat), u_a = e x (o_a - v0), u_b = (v0 - v1) x (o_b - v1):
+psi = atan2(Y, X), X = u_a . u_b, Y = (u_b x u_a) . e / l. Its derivatives in closed form (as Bridson
+et al. 2003 and Tamstorf & Grinspun 2013), per wing w = a, b with far vertex o_w: q_w = e x (o_w - v0),
+n = q_w / |q_w|, t = e_hat x n, height h = |q_w| / l, foot xi = (o_w - v0) . e / l^2, s = +1 on a, -1 on b:
 
   d psi / d o_w = s n / h,  d psi / d v1 = -xi s n / h,  d psi / d v0 = -(1 - xi) s n / h   (summed over w),
 
-and Hess psi is the sum of each wing's symmetric 9 x 9 on (v0, v1, o_w) (no o_a - o_b block), with
-coefficients c = (-(1 - xi), -xi, 1) and b = (-1, 1, 0) over (v0, v1, o_w) (b: e's), block (i, j)
+and Hess psi sums each wing's symmetric 9 x 9 on (v0, v1, o_w), with c = (-(1 - xi), -xi, 1) and
+b = (-1, 1, 0) over (v0, v1, o_w), block (i, j)
 
   s [(c_i c_j / h^2 + b_i b_j / (2 l^2)) (t n^T + n t^T) - (b_i c_j n e_hat^T + c_i b_j e_hat n^T) / (l h)]
 
-(from d(n / h) / d(o_w - v0) = (t n^T + n t^T) / h^2 and the chain rule through xi and l; the
-antisymmetric parts of the two wings' second derivatives in e alone cancel, so each is written
-symmetric).
+(d(n / h) / d(o_w - v0) = (t n^T + n t^T) / h^2 and the chain rule through xi and l; the two wings'
+antisymmetric parts in e alone cancel, so each is written symmetric).
 """
 from __future__ import annotations
 

@@ -278,3 +278,20 @@ def test_the_mid_edge_plate_needs_a_ghost_clamp_mesh():
     s = strip()
     with pytest.raises(InputError, match="ghost_clamp_mesh"):
         MidedgePlateModel(s, mesh=structured_mesh(s.length, s.width, 200))
+
+
+def test_a_model_built_by_the_caller_runs_the_same_path_as_simulate():
+    """ddg.api.simulate_model on a MidedgePlateModel gives the rows simulate gives for the same
+    mesh, and takes models simulate cannot build (a fixed membrane share)."""
+    import ddg
+    from ddg.api import simulate_model
+
+    s = strip()
+    mesh = ghost_clamp_mesh(s.length, s.width, rows=4)
+    protocol = ddg.LoadingProtocol(0.5, 0.1, compression_steps=4, shear_steps=3)
+    by_name = ddg.simulate(s, protocol, model="plate-midedge", mesh=mesh, thresholds=False, centerline=False)
+    built = simulate_model(MidedgePlateModel(s, mesh=mesh), protocol, thresholds=False, centerline=False)
+    assert [r["H_mid_over_L"] for r in built.rows] == [r["H_mid_over_L"] for r in by_name.rows]
+    smoothed = simulate_model(MidedgePlateModel(s, mesh=mesh, membrane_alpha=0.0), protocol, thresholds=False,
+                              centerline=False)
+    assert smoothed.summary["status"] == "complete" and len(smoothed.rows) == len(by_name.rows)

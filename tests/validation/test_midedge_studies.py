@@ -350,7 +350,7 @@ def _speed_targets_figures(stored: dict) -> str:
     where the 8-row run's iterations go."""
     runs = "; ".join(f"{t['rows']} rows {t['wall_time_s']:.2f} s (target {t['wall_target_s']:g} s), "
                      f"{t['iterations_per_step']:.2f} Newton iterations per recorded step "
-                     f"(target {t['iterations_per_step_target']:g})" for t in stored["targets"])
+                     f"(target {t['iterations_per_step_target']:g})" for t in _issue_29_targets(stored))
     first = min(stored["results"], key=lambda r: r["rows_target"])
     phases = first["newton_iterations_by_phase"]
     return (f"W/L = 1/6, dL/L = 1/2, full path with thresholds (benchmarks/results/midedge_path.json): {runs}; of "
@@ -358,6 +358,12 @@ def _speed_targets_figures(stored: dict) -> str:
             f"{phases['rejected steps']} are in failed solves, {phases['fold snaps']} in fold snaps and "
             f"{phases['branch switching']} in branch switching ({len(first['branch_switches_dW_over_L'])} "
             f"recorded steps with a branch switch)")
+
+
+def _issue_29_targets(stored: dict) -> list[dict]:
+    """The stored runs issue 29 set a wall time for (8 and 12 rows); a run of other rows (the 18-row
+    one of issue 50's breakdown) has none."""
+    return [t for t in stored["targets"] if t["wall_target_s"] is not None]
 
 
 def _speedup_figures(stored: dict) -> str:
@@ -383,7 +389,7 @@ def _stored_benchmark(name: str) -> dict:
 def test_midedge_plate_meets_the_issues_speed_targets_in_the_stored_benchmark(request):
     stored = _stored_benchmark("midedge_path")
     _xfail_if_unmet(request, "speed targets", lambda: _speed_targets_figures(stored))
-    targets = {t["rows"]: t for t in stored["targets"]}
+    targets = {t["rows"]: t for t in _issue_29_targets(stored)}
     assert set(targets) == {8, 12}, sorted(targets)
     for rows, t in targets.items():
         assert t["completed"], (rows, t)

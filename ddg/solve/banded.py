@@ -148,8 +148,19 @@ class SymmetricBanded:
         return a
 
     def scaled(self, s: np.ndarray) -> "SymmetricBanded":
-        """diag(s) A diag(s), still banded (used to normalise eigenvalues)."""
+        """diag(s) A diag(s), still banded (used to normalise eigenvalues). Where A's Cholesky was
+        tried, the scaled matrix inherits the outcome without factoring again (s > 0): its factor
+        is diag(s) L, L's rows scaled (the unique factor with a positive diagonal), and it is
+        positive definite exactly when A is (Sylvester's law of inertia)."""
         band = self.band * s[None, :]
         for d in range(band.shape[0]):
             band[d, : self.n - d] *= s[d:]
-        return SymmetricBanded(band)
+        out = SymmetricBanded(band)
+        if self._cholesky_tried and np.all(s > 0):
+            out._cholesky_tried = True
+            if self._cholesky is not None:
+                factor = self._cholesky.copy(order="K")  # LAPACK's (Fortran) layout: no copy per solve
+                for d in range(factor.shape[0]):
+                    factor[d, : self.n - d] *= s[d:]
+                out._cholesky = factor
+        return out

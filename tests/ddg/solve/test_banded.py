@@ -89,3 +89,19 @@ def test_lanczos_lowest_eigenvalue_from_the_cholesky_factor(seed):
     reference = np.linalg.eigvalsh(scaled)[0]
     assert abs(odd @ np.ones(n)) < 1e-12
     assert lowest_eigenvalue(K.cholesky_factor, metric) == pytest.approx(reference, rel=1e-10)
+
+
+@pytest.mark.parametrize("lowest", [2.0, -1.0])
+def test_a_scaled_matrix_inherits_the_cholesky_outcome(lowest):
+    """diag(s) A diag(s) after A's Cholesky: the factor diag(s) L equals a fresh factorisation of the
+    scaled matrix to round-off (1e-12 of its largest entry; measured ~1e-15), an indefinite A gives an
+    indefinite scaled matrix without a trial, and its lowest eigenvalues are the fresh ones'."""
+    K = random_banded(300, 10, lowest, seed=4)
+    s = np.random.default_rng(5).uniform(0.5, 2.0, 300)
+    K.cholesky()
+    inherited, fresh = K.scaled(s), SymmetricBanded(K.scaled(s).band.copy())
+    assert inherited.positive_definite == fresh.positive_definite == (lowest > 0)
+    if lowest > 0:
+        scale = np.abs(fresh.cholesky_factor).max()
+        assert np.abs(inherited.cholesky_factor - fresh.cholesky_factor).max() < 1e-12 * scale
+    np.testing.assert_allclose(inherited.lowest_eigenpairs(2), fresh.lowest_eigenpairs(2), rtol=1e-9, atol=1e-9)

@@ -14,7 +14,7 @@ about 1 - g times (on fine meshes; 0.65 on 8 rows at g = 0.5) and at the centre 
 1 + (pi/2 - 1) g times the uniform spacing; membrane_alpha
 fixes the constant-strain share of the PSRI membrane (default b^2 / h^2, which changes with h).
 
-The issue (50, item 3) names three candidates: the clamp's ghost columns, the membrane mix
+Three candidates were named for the irregular sequence: the clamp's ghost columns, the membrane mix
 alpha = b^2 / h^2 and the 12-row S window. dW1 precedes S, so the third cannot act on it; the
 studies below separate resolution across W (rows), along L (columns), the free-edge boundary
 layers (grading) and alpha.

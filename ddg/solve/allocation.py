@@ -1,14 +1,14 @@
 """Large arrays kept mapped from one Newton iteration to the next (glibc's malloc).
 
-A plate's banded Hessian holds (bandwidth + 1) n doubles: 8.6 MB on the mid-edge plate's 12 rows
-at W/L = 1/6, 96 MB on 28 rows; and every iteration makes three such arrays (the Hessian, its free
+A plate's banded Hessian holds (bandwidth + 1) n doubles, megabytes to hundreds of megabytes on
+fine meshes, and every iteration makes three such arrays (the Hessian, its free
 block, the Cholesky factor's copy) and frees them. glibc serves a block above its mmap threshold
 (self-adjusting, at most 32 MiB) with fresh pages from the kernel, and returns the heap's free top
 to the kernel once it exceeds the trim threshold (twice the mmap one), which three freed
 Hessian-sized blocks do: either way the next iteration's arrays are fresh pages again, and each
-pays a page fault per 4 KiB page when first written (zeroing and touching 96 MB: 90 ms, against 6 ms
-for the same block taken again from the heap; measured in benchmarks/results/plate_iteration.md and
-docs/findings/measured.md). `keep_large_blocks` raises both thresholds to LARGEST_HEAP_BLOCK, so
+pays a page fault per 4 KiB page when first written, where a block taken again from the heap is
+already mapped (measured in benchmarks/results/plate_iteration.md and docs/findings/measured.md).
+`keep_large_blocks` raises both thresholds to LARGEST_HEAP_BLOCK, so
 that such blocks come from the heap and stay mapped after they are freed: the process keeps its
 peak memory instead of returning it between iterations.
 
@@ -43,10 +43,10 @@ def keep_large_blocks(nbytes: int) -> bool:
         return False
     try:
         libc = ctypes.CDLL("libc.so.6")
-        version = libc.gnu_get_libc_version  # glibc only (musl has no mallopt thresholds)
-    except (OSError, AttributeError):
+    except OSError:
         return False
-    del version
+    if not hasattr(libc, "gnu_get_libc_version"):  # glibc only (musl has no mallopt thresholds)
+        return False
     ok = libc.mallopt(_M_MMAP_THRESHOLD, LARGEST_HEAP_BLOCK) == 1
     ok = ok and libc.mallopt(_M_TRIM_THRESHOLD, LARGEST_HEAP_BLOCK) == 1
     _state["active"] = bool(ok)

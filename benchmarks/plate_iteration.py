@@ -1,7 +1,10 @@
-"""One Newton iteration of the mid-edge plate, piece by piece, against another source tree.
+"""One Newton iteration of a plate, piece by piece, against another source tree.
 
     .venv/bin/python -m benchmarks.plate_iteration [--against DIR] [--rounds 3] [--rows 8 12 18 28]
-        [--out benchmarks/results]
+        [--model plate-midedge|plate] [--out benchmarks/results]
+
+--model plate times the paper's plate instead, `--rows` then giving its triangle counts (issue 50:
+2100 triangles <= 3 ms); it writes plate_iteration_paper.json and .md.
 
 Issue 50's per-iteration targets (mid-edge 12 rows <= 6 ms, 28 rows <= 50 ms) split into what an
 iteration of ddg.solve.newton does on a positive definite Hessian: `model.evaluate` with gradient
@@ -32,19 +35,22 @@ from benchmarks.common import load_average, machine_info, markdown_table, source
 REPO = Path(__file__).resolve().parents[1]
 ROWS = (8, 12, 18, 28)
 PIECES = ("evaluate", "free block", "Cholesky", "solve")
-#: issue 50's targets per Newton iteration (ms)
-TARGET_MS = {12: 6.0, 28: 50.0}
+#: issue 50's targets per Newton iteration (ms), per model and mesh (rows; triangles for the paper's plate)
+TARGET_MS = {"plate-midedge": {12: 6.0, 28: 50.0}, "plate": {2100: 3.0}}
+MESH_WORD = {"plate-midedge": "rows", "plate": "triangles"}
+REPORT_NAME = {"plate-midedge": "plate_iteration", "plate": "plate_iteration_paper"}
 
 CHILD = r"""
 import json, statistics, sys, time
 import numpy as np
 import ddg
 from ddg.models.midedge_plate import MidedgePlateModel
+from ddg.models.plate import PlateModel
 
 out = []
 for rows in json.loads(sys.argv[1]):
     strip = ddg.Strip.from_ratios(1 / 6, 0.5)
-    model = MidedgePlateModel(strip, rows=rows)
+    model = PlateModel(strip, rows) if sys.argv[2] == "plate" else MidedgePlateModel(strip, rows=rows)
     rng = np.random.default_rng(rows)
     q = model.rest_state() + 1e-7 * strip.length * rng.standard_normal(model.n_dof)
     times = {k: [] for k in ("evaluate", "free block", "Cholesky", "solve")}
@@ -70,8 +76,8 @@ print(json.dumps(out))
 """
 
 
-def one_round(tree: Path, rows, env: dict) -> list[dict]:
-    done = subprocess.run([sys.executable, "-c", CHILD, json.dumps(list(rows))], cwd=tree, capture_output=True,
+def one_round(tree: Path, rows, env: dict, model: str = "plate-midedge") -> list[dict]:
+    done = subprocess.run([sys.executable, "-c", CHILD, json.dumps(list(rows)), model], cwd=tree, capture_output=True,
                           text=True, check=True, timeout=1800,
                           env={**os.environ, "PYTHONPATH": str(tree), "OPENBLAS_NUM_THREADS": "1", **env})
     return json.loads(done.stdout.splitlines()[-1])
@@ -79,10 +85,12 @@ def one_round(tree: Path, rows, env: dict) -> list[dict]:
 
 def markdown(report: dict) -> str:
     configs = list(report["results"])
-    lines = ["# Mid-edge plate: one Newton iteration, piece by piece", "",
+    model = report.get("model", "plate-midedge")
+    title = {"plate-midedge": "Mid-edge plate", "plate": "The paper's plate"}[model]
+    lines = [f"# {title}: one Newton iteration, piece by piece", "",
              "`python -m benchmarks.plate_iteration` (the module docstring gives the method); W/L = 1/6, dL/L = 1/2, "
              "L/b = 1181; ms, minimum over rounds of the median over calls; one BLAS thread.", ""]
-    header = ["rows", "free DOF", "bandwidth", "tree"] + list(PIECES) + ["total"]
+    header = [MESH_WORD[model], "free DOF", "bandwidth", "tree"] + list(PIECES) + ["total"]
     rows = []
     for i, r in enumerate(report["results"][configs[0]]):
         for c in configs:
@@ -91,9 +99,10 @@ def markdown(report: dict) -> str:
                         + [f"{x[p]:.2f}" for p in PIECES] + [f"{sum(x[p] for p in PIECES):.2f}"])
     lines += markdown_table(header, rows).splitlines()
     lines += ["", "Targets (issue 50, per Newton iteration): "
-              + "; ".join(f"{r} rows <= {t:g} ms" for r, t in TARGET_MS.items()) + ". An iteration of the path does "
-              "about 1.35 evaluations with the Hessian (benchmarks/results/midedge_path.md) and, at the accepted "
-              "states, the stability test's eigen-solves: the pieces above are its floor.", "",
+              + "; ".join(f"{r} {MESH_WORD[model]} <= {t:g} ms" for r, t in TARGET_MS[model].items())
+              + ". An iteration of the path does "
+              "more than one evaluation with the Hessian (mid-edge: about 1.35, benchmarks/results/midedge_path.md) "
+              "and, at the accepted states, the stability test's eigen-solves: the pieces above are its floor.", "",
               f"Configurations: {json.dumps(report['configurations'])}; rounds {report['rounds']}; load average "
               f"{report['load_before']} before, {report['load_after']} after; ddg sources sha256 "
               f"`{report['sources']}`; {report['machine'].get('cpu', '')}."]
@@ -105,6 +114,7 @@ def main(argv=None) -> int:
     parser.add_argument("--against", type=Path, default=None)
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--rows", type=int, nargs="+", default=list(ROWS))
+    parser.add_argument("--model", choices=sorted(MESH_WORD), default="plate-midedge")
     parser.add_argument("--out", type=Path, default=REPO / "benchmarks" / "results")
     args = parser.parse_args(argv)
     configs = {"this": (REPO, {}), "this, DDG_MALLOC=default": (REPO, {"DDG_MALLOC": "default"})}
@@ -114,7 +124,7 @@ def main(argv=None) -> int:
     best: dict = {}
     for _ in range(args.rounds):
         for name, (tree, env) in configs.items():
-            new = one_round(tree, args.rows, env)
+            new = one_round(tree, args.rows, env, args.model)
             if name not in best:
                 best[name] = new
             else:
@@ -122,11 +132,11 @@ def main(argv=None) -> int:
                     for p in PIECES:
                         old[p] = min(old[p], fresh[p])
             print(name, [(r["rows"], round(sum(r[p] for p in PIECES), 2)) for r in new], flush=True)
-    report = {"results": best, "rounds": args.rounds,
+    report = {"model": args.model, "results": best, "rounds": args.rounds,
               "configurations": {k: [str(t), e] for k, (t, e) in configs.items()},
               "load_before": load_before, "load_after": load_average(), "sources": source_fingerprint(),
               "machine": machine_info(blas=True)}
-    print(write_report(args.out, "plate_iteration", report, markdown(report)))
+    print(write_report(args.out, REPORT_NAME[args.model], report, markdown(report)))
     return 0
 
 

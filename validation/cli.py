@@ -15,7 +15,7 @@ def commands() -> dict[str, tuple[object, str]]:
     """Subcommand -> (the module that declares and runs it, its one-line help), in the order
     `python -m validation --help` lists them."""
     from . import (benchmark, locking, midedge_convergence, narrow_limit, paper_figures, plate_gold, plate_mesh_scan,
-                   plate_modes, report,
+                   plate_modes, report, ribbon_reconciliation,
                    ribbon_regularisation, score, wide_check)
     from .error_map import command as error_map
 
@@ -42,6 +42,8 @@ def commands() -> dict[str, tuple[object, str]]:
                                              "(data/plate_modes)"),
         "paper-figures": (paper_figures, "the data of the paper's Fig. 9: deformed plates and the centreline "
                                          "approximation's error (data/paper_figures)"),
+        "ribbon-reconciliation": (ribbon_reconciliation, "our ribbons on Panda and Jawed's scene beside the shell "
+                                                         "(data/ribbon_reconciliation)"),
         "ribbon-regularisation": (ribbon_regularisation, "the Wunderlich ribbon's thresholds against its "
                                                          "regularisation (data/ribbon_regularisation)"),
     }

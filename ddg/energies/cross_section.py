@@ -370,6 +370,18 @@ def add_torsion_warping_partials(f_u, f_uu, pair_first, pair_second, end_first, 
 
 
 @njit(cache=True)
+def add_pair_partials(f_u, f_uu, pair_first, pair_second, index):
+    """A pair energy's per-stencil partials (torsion_warping_terms' pairs, in the strain at
+    u[index] of neighbouring stencils) added into the stencils' f_u (n, k) and f_uu (n, k, k); the
+    mixed partials pair_second[:, 0, 1] couple two stencils (rod_curvature.add_pair_cross_terms)."""
+    for i in range(f_u.shape[0] - 1):
+        f_u[i, index] += pair_first[i, 0]
+        f_u[i + 1, index] += pair_first[i, 1]
+        f_uu[i, index, index] += pair_second[i, 0, 0]
+        f_uu[i + 1, index, index] += pair_second[i, 1, 1]
+
+
+@njit(cache=True)
 def modes_bending_terms(rows, cols, values, q, n_dof, want_gradient, want_hessian, grad, band):
     """Eq. X' as the constant quadratic form 1/2 q . K q of modes_curvature_form (K's lower triangle
     rows >= cols, values): returns the energy, adds K q to grad and K's entries to the flattened

@@ -32,8 +32,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ..energies.cross_section import (add_torsion_warping_partials, field_kernel, modes_bending_terms,
-                                      torsion_warping_terms)
+from ..energies.cross_section import (add_pair_partials, add_torsion_warping_partials, field_kernel,
+                                      modes_bending_terms, torsion_warping_terms)
 from ..energies.rod_bending import bending_density
 from ..energies.rod_curvature import (STENCIL_SIZE, add_pair_cross_terms, add_stencil_terms,
                                       add_stretched_stencil_terms, curvature_rows)
@@ -49,7 +49,7 @@ from ..solve.compiled_newton import CompiledLoops, compile_loops
 
 #: The parts rod_energy returns, in its order (zero where the model has no such term).
 PARTS = ("stretching", "bending", "twisting", "sadowsky", "trapeze", "wunderlich", "cross_section",
-         "torsion_warping", "cross_section_bending")
+         "torsion_warping", "cross_section_bending", "curvature_gradient")
 
 #: The kinds of width terms (the first entry of `width_terms`).
 ROD, TRAPEZE, WUNDERLICH, CROSS_SECTION = range(4)
@@ -65,10 +65,10 @@ def width_terms(kind: int = ROD, reals=(), vectors=(), matrices=(), indices=(), 
 
     - TRAPEZE: reals (C3, C5) of ddg.energies.trapeze;
     - WUNDERLICH: reals (W,), vectors (pair lengths, regularisation dl / zeta per stencil);
-    - CROSS_SECTION: reals (E b, D, nu, W, E Gamma), vectors (pair lengths, m, p, a, the bending
-      form's values), matrices (S, P, Q, Psi, the constant Hessian) of CrossSectionModes, indices
-      (the modes' places in a stencil's block, the bending form's rows and columns), table the
-      modes' DOFs (edges, modes)."""
+    - CROSS_SECTION: reals (E b, D, nu, W, E Gamma, B_k: the curvature gradient's stiffness),
+      vectors (pair lengths, m, p, a, the bending form's values), matrices (S, P, Q, Psi, the
+      constant Hessian) of CrossSectionModes, indices (the modes' places in a stencil's block, the
+      bending form's rows and columns), table the modes' DOFs (edges, modes)."""
     def padded(items, count, make):
         items = [np.ascontiguousarray(a) for a in items]
         return tuple(items + [make() for _ in range(count - len(items))])
@@ -162,6 +162,10 @@ def _cross_section(q, x, kappa_n, kappa_g, tau, first, second, rest_lengths, vor
     field_kernel(eps, kappa_n, kappa_g, tau, c[:-1], c[1:], voronoi, m, big_s, big_p, p, big_q, a, big_psi,
                   reals[0], reals[1], reals[2], reals[3], h_g, energy, f_u, f_uu)
     pairs, pf, ps, ends, ef, es = torsion_warping_terms(tau, voronoi, pair_lengths, reals[4])
+    curvature_gradient = reals[5] > 0.0
+    if curvature_gradient:  # B_k / 2 int kappa_n'^2 (CrossSectionRibbon's curvature_gradient; zero by default)
+        gradient_pairs, kf, ks, _, _, _ = torsion_warping_terms(kappa_n, voronoi, pair_lengths, reals[5])
+        parts[9] = gradient_pairs.sum()
     parts[6] = energy.sum()
     parts[7] = pairs.sum() + ends.sum()
     parts[8] = modes_bending_terms(rows, cols, form, q, n_dof, want_gradient, want_hessian, grad, band)
@@ -174,11 +178,20 @@ def _cross_section(q, x, kappa_n, kappa_g, tau, first, second, rest_lengths, vor
             for b in range(3):
                 f_uu[i, 1 + a, 1 + b] += second[i, a, b]
     add_torsion_warping_partials(f_u, f_uu, pf, ps, ef, es)
+    if curvature_gradient:
+        add_pair_partials(f_u, f_uu, kf, ks, 1)
     gradients = np.empty((count if want_hessian else 0, 4, STENCIL_SIZE))
     add_stretched_stencil_terms(x, m1, m2, rest_lengths, f_u, f_uu, node_stride, unit_place, n_dof, grad, band,
                                 want_hessian, gradients)
     if want_hessian:
-        add_pair_cross_terms(gradients, ps[:, 0:1, 1:2].copy(), np.array([3]), node_stride, n_dof, band)
+        if curvature_gradient:
+            cross = np.zeros((count - 1, 2, 2))
+            for i in range(count - 1):
+                cross[i, 0, 0] = ks[i, 0, 1]
+                cross[i, 1, 1] = ps[i, 0, 1]
+            add_pair_cross_terms(gradients, cross, np.array([1, 3]), node_stride, n_dof, band)
+        else:
+            add_pair_cross_terms(gradients, ps[:, 0:1, 1:2].copy(), np.array([3]), node_stride, n_dof, band)
 
 
 #: The kind of width terms a specialisation of the energy adds (bound per specialisation by

@@ -30,8 +30,8 @@ import math
 
 import numpy as np
 
-from ..energies.cross_section import (CrossSectionModes, add_torsion_warping_partials, field_density,
-                                      modes_bending_terms, modes_curvature_form, torsion_warping,
+from ..energies.cross_section import (CrossSectionModes, add_pair_partials, add_torsion_warping_partials,
+                                      field_density, modes_bending_terms, modes_curvature_form, torsion_warping,
                                       torsion_warping_stiffness)
 from ..energies.rod_curvature import (STENCIL_SIZE, add_pair_cross_terms, add_stretched_stencil_terms,
                                       material_curvatures)
@@ -105,15 +105,22 @@ class TrapezeRibbon(RodModel):
 
 class CrossSectionRibbon(RodModel):
     """The DAR plus its cross-section as a field (ddg.energies.cross_section, Eqs. X, X' and V):
-    `modes` DOFs per edge after the twist angle (node_stride 4 + modes), zero on the clamped edges."""
+    `modes` DOFs per edge after the twist angle (node_stride 4 + modes), zero on the clamped edges.
+    `curvature_gradient` l > 0 adds B_k / 2 int kappa_n'^2, B_k = EI2 (l W)^2, over neighbouring
+    stencils as Eq. V (without its clamp terms): a study option, zero by default; what it changes is
+    measured in docs/findings/models.md (validation ribbon-reconciliation)."""
 
     name = CROSS_SECTION_RIBBON
     edge_fields = 2
 
-    def __init__(self, strip: Strip, nodes: int = 101, modes: int | None = None):
+    def __init__(self, strip: Strip, nodes: int = 101, modes: int | None = None, curvature_gradient: float = 0.0):
         if modes is not None:
             self.edge_fields = modes
         super().__init__(strip, nodes)
+        #: B_k = EI2 (l W)^2 of the normal curvature's gradient energy B_k / 2 int kappa_n'^2, l = curvature_gradient
+        self.curvature_gradient_stiffness = strip.bending_stiffness * (float(curvature_gradient) * strip.width) ** 2
+        if self.curvature_gradient_stiffness > 0.0:
+            self.energy_parts = type(self).energy_parts + ("curvature_gradient",)
         self.modes = CrossSectionModes(strip.width, strip.thickness, strip.young_modulus, strip.poisson_ratio,
                                        self.edge_fields)
         stride = self.node_stride
@@ -133,7 +140,8 @@ class CrossSectionRibbon(RodModel):
     def width_terms(self):
         m = self.modes
         rows, cols, values = self._bending_form
-        return width_terms(CROSS_SECTION, (m.membrane, m.plate, m.poisson_ratio, m.width, self.warping_stiffness),
+        return width_terms(CROSS_SECTION, (m.membrane, m.plate, m.poisson_ratio, m.width, self.warping_stiffness,
+                                           self.curvature_gradient_stiffness),
                            (self.pair_lengths, m.m, m.p, m.a, values), (m.S, m.P, m.Q, m.Psi, m.constant_hessian),
                            (self._mode_place, rows, cols), self.field_dofs)
 
@@ -149,19 +157,27 @@ class CrossSectionRibbon(RodModel):
         pairs, pair_first, pair_second, ends, end_first, end_second = torsion_warping(
             tau, self.voronoi_lengths, self.pair_lengths, self.warping_stiffness)
         bending = modes_bending_terms(*self._bending_form, q, self.n_dof, gradient, hessian, grad, band)
+        gradient_pairs, k_first, k_second, _, _, _ = torsion_warping(kappa_n, self.voronoi_lengths, self.pair_lengths,
+                                                                     self.curvature_gradient_stiffness)
         if gradient:
             # u = (eps, kappa_n, kappa_g, tau, modes): the rod's own partials and Eq. V's per-twist parts join Eq. X's
             f_u[:, 1:4] += first
             f_uu[:, 1:4, 1:4] += second
             add_torsion_warping_partials(f_u, f_uu, pair_first, pair_second, end_first, end_second)
+            add_pair_partials(f_u, f_uu, k_first, k_second, 1)
             strain_gradients = np.empty((len(tau) if hessian else 0, 4, STENCIL_SIZE))
             add_stretched_stencil_terms(x, m1, m2, self.rest_edge_lengths, f_u, f_uu, self.node_stride,
                                         self._mode_place, self.n_dof, grad, band, hessian, strain_gradients)
             if hessian:
-                add_pair_cross_terms(strain_gradients, np.ascontiguousarray(pair_second[:, 0:1, 1:2]), np.array([3]),
-                                     self.node_stride, self.n_dof, band)
-        return {"cross_section": float(energy.sum()), "torsion_warping": float(pairs.sum() + ends.sum()),
-                "cross_section_bending": float(bending)}
+                cross = np.zeros((len(tau) - 1, 2, 2))
+                cross[:, 0, 0] = k_second[:, 0, 1]
+                cross[:, 1, 1] = pair_second[:, 0, 1]
+                add_pair_cross_terms(strain_gradients, cross, np.array([1, 3]), self.node_stride, self.n_dof, band)
+        parts = {"cross_section": float(energy.sum()), "torsion_warping": float(pairs.sum() + ends.sum()),
+                 "cross_section_bending": float(bending)}
+        if self.curvature_gradient_stiffness > 0.0:
+            parts["curvature_gradient"] = float(gradient_pairs.sum())
+        return parts
 
     def residual_floor(self) -> float:
         """The rod's floor times (W / h)^2 / 25 where that is above 1: the modes' membrane terms

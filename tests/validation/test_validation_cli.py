@@ -20,7 +20,8 @@ OLD_SPELLING = {"report": "validation.report", "score": "validation.score", "ben
                 "locking": "validation.locking", "plate-modes": "validation.plate_modes",
                 "plate-mesh-scan": "validation.plate_mesh_scan", "paper-figures": "validation.paper_figures",
                 "ribbon-regularisation": "validation.ribbon_regularisation",
-                "midedge-convergence": "validation.midedge_convergence"}
+                "midedge-convergence": "validation.midedge_convergence",
+                "ribbon-reconciliation": "validation.ribbon_reconciliation"}
 
 
 def test_every_command_of_validation_is_a_subcommand():

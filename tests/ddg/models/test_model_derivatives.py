@@ -267,11 +267,13 @@ def plate_shape_measures(model: PlateModel, q: np.ndarray) -> dict:
 
 # --------------------------------------------------------------------------- rod and ribbon: models and states
 ROD_MODELS = ("rod", "ribbon zeta=0.5L", "ribbon zeta=10L", "ribbon-sano-wada", "ribbon-trapeze",
-              "ribbon-cross-section", "ribbon-wunderlich")
+              "ribbon-cross-section", "ribbon-cross-section l=0.3W", "ribbon-wunderlich")
 #: The energy parts each rod-family model reports beyond the rod's stretching, bending, twisting.
 EXTRA_PARTS = {"rod": set(), "ribbon zeta=0.5L": {"sadowsky"}, "ribbon zeta=10L": {"sadowsky"},
                "ribbon-sano-wada": {"sadowsky"}, "ribbon-trapeze": {"trapeze"},
                "ribbon-cross-section": {"cross_section", "torsion_warping", "cross_section_bending"},
+               "ribbon-cross-section l=0.3W": {"cross_section", "torsion_warping", "cross_section_bending",
+                                               "curvature_gradient"},
                "ribbon-wunderlich": {"sadowsky", "wunderlich"}}
 #: Parts that may be negative: the trapeze coupling E b W^3 eps tau^2 / 24 where the centreline
 #: is compressed (eps < 0); with the stretching it forms a non-negative square (ddg.energies.trapeze).
@@ -293,6 +295,8 @@ def rod_family_model(kind: str, nodes: int) -> RodModel:
         return TrapezeRibbon(strip(0.2 * LENGTH), nodes)
     if kind == "ribbon-cross-section":
         return CrossSectionRibbon(strip(0.2 * LENGTH), nodes)
+    if kind == "ribbon-cross-section l=0.3W":  # the normal curvature's gradient energy, B_k = EI2 (0.3 W)^2
+        return CrossSectionRibbon(strip(0.2 * LENGTH), nodes, curvature_gradient=0.3)
     if kind == "ribbon-wunderlich":
         # W/L = 1/20 and zeta = 0.2 L keep the random states' |W eta'| at 0.1-1.3, inside the ruling
         # factor's pole at 2 (at W/L = 1/5 they cross it); g(v) - 1 then holds 1e-5 .. 5e-2 of the energy

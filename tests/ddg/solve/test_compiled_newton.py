@@ -62,8 +62,12 @@ def test_a_singular_band_is_reported_not_solved():
     assert not ok
 
 
+def _curvature_gradient_cross_section(strip, nodes):
+    return CrossSectionRibbon(strip, nodes, curvature_gradient=0.3)
+
+
 @pytest.mark.parametrize("cls", [RodModel, RibbonModel, SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon,
-                                 CrossSectionRibbon])
+                                 CrossSectionRibbon, _curvature_gradient_cross_section])
 def test_the_one_call_assembly_is_the_piecewise_one(cls):
     """Energy, gradient, Hessian and frames of rod_energy against the model's composition of the
     same pieces (evaluate_piecewise, the path checked against finite differences in

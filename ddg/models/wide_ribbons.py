@@ -41,10 +41,15 @@ from ..energies.stencil_coupling import (add_local_terms, pair_blocks, stencil_s
 from ..energies.trapeze import trapeze_coefficients, trapeze_density
 from ..energies.wunderlich import POLE, wunderlich_pair_density
 from ..geometry.strip import Strip
+from ..limits import check_option
 from .ribbon import RibbonModel
 from .rod import RodModel
 from .rod_assembly import CROSS_SECTION, PARTS, TRAPEZE, WUNDERLICH, width_terms
 from .names import CROSS_SECTION_RIBBON, SANO_WADA_RIBBON, TRAPEZE_RIBBON, WUNDERLICH_RIBBON
+
+#: The largest curvature-gradient length of CrossSectionRibbon, in widths: a length of several W
+#: would make the term stiffer than the bending it regularises on any shape of the strip.
+MAX_CURVATURE_GRADIENT = 10.0
 
 __all__ = ["SanoWadaRibbon", "TrapezeRibbon", "CrossSectionRibbon", "WunderlichRibbon", "sano_wada_zeta",
            "WIDE_RIBBONS"]
@@ -114,11 +119,13 @@ class CrossSectionRibbon(RodModel):
     edge_fields = 2
 
     def __init__(self, strip: Strip, nodes: int = 101, modes: int | None = None, curvature_gradient: float = 0.0):
+        length = check_option("CrossSectionRibbon", "curvature_gradient", curvature_gradient, "float", 0.0,
+                              MAX_CURVATURE_GRADIENT)
         if modes is not None:
             self.edge_fields = modes
         super().__init__(strip, nodes)
         #: B_k = EI2 (l W)^2 of the normal curvature's gradient energy B_k / 2 int kappa_n'^2, l = curvature_gradient
-        self.curvature_gradient_stiffness = strip.bending_stiffness * (float(curvature_gradient) * strip.width) ** 2
+        self.curvature_gradient_stiffness = strip.bending_stiffness * (length * strip.width) ** 2
         if self.curvature_gradient_stiffness > 0.0:
             self.energy_parts = type(self).energy_parts + ("curvature_gradient",)
         self.modes = CrossSectionModes(strip.width, strip.thickness, strip.young_modulus, strip.poisson_ratio,

@@ -20,7 +20,7 @@ from ddg.energies.rod_curvature import material_curvatures
 from ddg.energies.rod_twist import discrete_twist
 from ddg.energies.wunderlich import SERIES_BELOW, ruling_factor
 from ddg.models.rod import RodModel
-from ddg.models.wide_ribbons import (SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon,
+from ddg.models.wide_ribbons import (CrossSectionRibbon, SanoWadaRibbon, TrapezeRibbon, WunderlichRibbon,
                                      sano_wada_zeta)
 
 WIDE_RIBBONS = ("ribbon-sano-wada", "ribbon-trapeze", "ribbon-cross-section", "ribbon-wunderlich")
@@ -183,6 +183,15 @@ def test_zeta_is_refused_where_it_does_not_apply():
     for model in ("rod", "ribbon-trapeze", "ribbon-sano-wada"):
         with pytest.raises(ddg.InputError, match="zeta applies"):
             ddg.simulate(strip, protocol, model=model, zeta=0.1)
+
+
+@pytest.mark.parametrize("length", [-0.1, float("nan"), float("inf"), 11.0, "0.2", True])
+def test_a_curvature_gradient_outside_its_range_is_refused_in_one_line(length):
+    """CrossSectionRibbon's curvature_gradient (in widths) is a number in [0, 10]: anything else is an
+    InputError naming the value and the range, before the model is built."""
+    with pytest.raises(ddg.InputError, match=r"curvature_gradient=.*") as refused:
+        CrossSectionRibbon(ddg.Strip.from_ratios(0.05, 0.5), 11, curvature_gradient=length)
+    assert "\n" not in str(refused.value)
 
 
 def test_wunderlich_strains_are_consistent_with_the_model():

@@ -99,7 +99,10 @@ DDG_ENTRY_POINTS = (
     ("ddg.models.plate", "PlateModel", "evaluate"),
     ("ddg.solve.dynamics", "ImplicitEuler", "__init__"),
     ("ddg.solve.dynamics", "ImplicitEuler", "advance"),
-    ("ddg.geometry.mesh_io", None, "_gmsh_generate"),
+    # gmsh's import, initialisation and meshing: the pytest worker running the valid gmsh case under
+    # the case's memory ceiling crashed once (1 of 7 clean-clone runs, in gmsh's initialise or
+    # finalise, the only native code the case reached), so none of gmsh runs inside a case
+    ("ddg.geometry.mesh_io", None, "_gmsh_session"),
     # the study generators and the sweep hand their runs to Dask workers here: past every check
     ("ddg.sweep.cluster", None, "run_all"),
 )

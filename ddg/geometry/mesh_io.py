@@ -162,6 +162,16 @@ def gmsh_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANGLES,
         and 0 < clamp_depth < 0.5 * length
     ):
         raise InputError(f"clamp_depth = {clamp_depth!r} must be a number in (0, L/2 = {0.5 * length:g}) metres")
+    nodes, tris, c = _gmsh_session(length, width, triangles, clamp_depth)
+    mesh = mesh_from_arrays(nodes, tris, length, width, clamp_depth=c)
+    check_mesh_memory(mesh)  # the estimate above took the band of a typical unstructured mesh
+    return mesh
+
+
+def _gmsh_session(length: float, width: float, triangles: int, clamp_depth: float | None):
+    """gmsh imported, initialised (unless it is already), the strip meshed twice (the calibration
+    pass) and gmsh left as it was found: nodes (N, 2), triangles (T, 3) and the clamp depth. Called
+    by gmsh_mesh once its inputs are checked; everything gmsh does happens here."""
     try:
         # importing Debian's gmsh 4.8 resets SIGINT to the default (kill) until finalize;
         # keep the caller's handler (and never touch signals off the main thread)
@@ -213,9 +223,7 @@ def gmsh_mesh(length: float, width: float, triangles: int = DEFAULT_TRIANGLES,
                 gmsh.model.setCurrent(previous_model)
         if main_thread and sigint is not None:
             signal.signal(signal.SIGINT, sigint)
-    mesh = mesh_from_arrays(nodes, tris, length, width, clamp_depth=c)
-    check_mesh_memory(mesh)  # the estimate above took the band of a typical unstructured mesh
-    return mesh
+    return nodes, tris, c
 
 
 def _count_between_clamps(nodes: np.ndarray, tris: np.ndarray, length: float) -> int:

@@ -91,7 +91,7 @@ def test_gmsh_mesh_refuses_a_size_beyond_the_memory_before_meshing(monkeypatch):
     def tripwire(*args, **kwargs):
         raise AssertionError("gmsh was called")
 
-    monkeypatch.setattr(mesh_io, "_gmsh_generate", tripwire)
+    monkeypatch.setattr(mesh_io, "_gmsh_session", tripwire)
     monkeypatch.setattr(ddg.limits, "available_memory_bytes", lambda: 2.0**20)
     with pytest.raises(InputError) as excinfo:
         gmsh_mesh(L, W, 2000)

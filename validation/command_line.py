@@ -37,3 +37,35 @@ def output_folder(path):
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return None
+
+
+def check_run_names(runs, only) -> None:
+    """--only's names refused in one line (exit 2) where one is not a run of the study."""
+    unknown = [n for n in (only or ()) if n not in {r.name for r in runs}]
+    if unknown:
+        refuse(f"--only {unknown[0]!r} is not a run; the runs are {', '.join(r.name for r in runs)}")
+
+
+def resumable_runs(runs, only, out, columns, run_one, table: str = "runs.csv") -> list[dict]:
+    """A study's fixed list of runs (each with a `name`), resumable: the runs not yet in OUT/table
+    (and in `only`, where given: check_run_names first) computed one by one by run_one(run) -> row,
+    the table rewritten after each so an interrupted study keeps every finished run. Returns the
+    rows in the list's order."""
+    import csv
+
+    from ddg.output.io import write_table_csv
+
+    path = out / table
+    done = {}
+    if path.exists():
+        with open(path, newline="") as fh:
+            done = {r["name"]: r for r in csv.DictReader(fh)}
+    for r in runs:
+        if r.name in done or (only and r.name not in only):
+            continue
+        done[r.name] = run_one(r)
+        write_table_csv(path, [done[x.name] for x in runs if x.name in done], columns)
+        row = done[r.name]
+        print(f"{r.name}: dW1/L = {row.get('dW1_over_L')}, dW2/L = {row.get('dW2_over_L', '-')}, "
+              f"{row.get('wall_time_s')} s", flush=True)
+    return [done[x.name] for x in runs if x.name in done]

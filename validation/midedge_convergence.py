@@ -21,14 +21,13 @@ layers (grading) and alpha.
 """
 from __future__ import annotations
 
-import csv
 import math
 import time
 from dataclasses import dataclass
 
-from ddg.output.io import atomic_write_text, write_table_csv
+from ddg.output.io import atomic_write_text
 
-from .command_line import output_folder, refuse
+from .command_line import check_run_names, output_folder, resumable_runs
 
 COMPRESSION_RATIO = 0.5
 #: past dW1 (about 0.27 at W/L = 1/6, 0.16 at 1/2) and before the path leaves US
@@ -224,30 +223,13 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     """The runs not yet in OUT/runs.csv, one after the other, the CSV and convergence.md rewritten after each."""
-    known = {r.name: r for r in RUNS}
-    if args.only:
-        unknown = [n for n in args.only if n not in known]
-        if unknown:
-            refuse(f"--only {unknown[0]!r} is not a run; the runs are {', '.join(known)}")
+    check_run_names(RUNS, args.only)
     out = output_folder(args.out)
     if out is None:
         return 2
-    path = out / "runs.csv"
-    done = {}
-    if path.exists():
-        with open(path, newline="") as fh:
-            done = {r["name"]: r for r in csv.DictReader(fh)}
-    for r in RUNS:
-        if r.name in done or (args.only and r.name not in args.only):
-            continue
-        done[r.name] = run_one(r)
-        ordered = [done[x.name] for x in RUNS if x.name in done]
-        write_table_csv(path, ordered, COLUMNS)
-        print(f"{r.name}: dW1/L = {done[r.name]['dW1_over_L']}, {done[r.name]['wall_time_s']} s", flush=True)
-    ordered = [done[x.name] for x in RUNS if x.name in done]
-    atomic_write_text(out / "convergence.md", report(ordered))
+    rows = resumable_runs(RUNS, args.only, out, COLUMNS, run_one)
+    atomic_write_text(out / "convergence.md", report(rows))
     return 0
-
 
 
 def main(argv=None) -> int:

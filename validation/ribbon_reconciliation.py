@@ -24,16 +24,15 @@ RibbonModel (the rod's GJ plus the quartic term) at a given zeta / L.
 """
 from __future__ import annotations
 
-import csv
 import json
 import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ddg.output.io import atomic_write_text, write_table_csv
+from ddg.output.io import atomic_write_text
 
-from .command_line import output_folder, refuse
+from .command_line import check_run_names, output_folder, resumable_runs
 
 #: Their strip: free span over nominal length (0.0807 m of 0.1 m at 63 nodes), their compression 0.025 m.
 SPAN_FRACTION = 0.0807 / 0.1
@@ -265,28 +264,12 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     """The runs not yet in OUT/runs.csv, the CSV and reconciliation.md rewritten after each."""
-    known = {r.name: r for r in RUNS}
-    if args.only:
-        unknown = [n for n in args.only if n not in known]
-        if unknown:
-            refuse(f"--only {unknown[0]!r} is not a run; the runs are {', '.join(known)}")
+    check_run_names(RUNS, args.only)
     out = output_folder(args.out)
     if out is None:
         return 2
-    path = out / "runs.csv"
-    done = {}
-    if path.exists():
-        with open(path, newline="") as fh:
-            done = {r["name"]: r for r in csv.DictReader(fh)}
-    for r in RUNS:
-        if r.name in done or (args.only and r.name not in args.only):
-            continue
-        done[r.name] = run_one(r)
-        write_table_csv(path, [done[x.name] for x in RUNS if x.name in done], COLUMNS)
-        print(f"{r.name}: dW1/L = {done[r.name]['dW1_over_L']}, dW2/L = {done[r.name]['dW2_over_L']}, "
-              f"{done[r.name]['wall_time_s']} s", flush=True)
-    atomic_write_text(out / "reconciliation.md", report([done[x.name] for x in RUNS if x.name in done],
-                                                        fem_rows(out / "fem")))
+    rows = resumable_runs(RUNS, args.only, out, COLUMNS, run_one)
+    atomic_write_text(out / "reconciliation.md", report(rows, fem_rows(out / "fem")))
     return 0
 
 

@@ -352,24 +352,6 @@ def torsion_warping_terms(tau, ell, pair_lengths, stiffness):
 
 
 @njit(cache=True)
-def add_torsion_warping_partials(f_u, f_uu, pair_first, pair_second, end_first, end_second):
-    """Eq. V's partials per twist (torsion_warping's pairs and clamp terms) added into the
-    stencils' partials f_u (n, k) and f_uu (n, k, k) in u = (eps, kappa_n, kappa_g, tau, ...), the
-    twist at u[3]. The mixed partials of neighbouring twists (pair_second[:, 0, 1]) couple two
-    stencils: rod_curvature.add_pair_cross_terms adds them."""
-    count = f_u.shape[0]
-    for i in range(count - 1):
-        f_u[i, 3] += pair_first[i, 0]
-        f_u[i + 1, 3] += pair_first[i, 1]
-        f_uu[i, 3, 3] += pair_second[i, 0, 0]
-        f_uu[i + 1, 3, 3] += pair_second[i, 1, 1]
-    f_u[0, 3] += end_first[0]
-    f_u[count - 1, 3] += end_first[1]
-    f_uu[0, 3, 3] += end_second[0]
-    f_uu[count - 1, 3, 3] += end_second[1]
-
-
-@njit(cache=True)
 def add_pair_partials(f_u, f_uu, pair_first, pair_second, index):
     """A pair energy's per-stencil partials (torsion_warping_terms' pairs, in the strain at
     u[index] of neighbouring stencils) added into the stencils' f_u (n, k) and f_uu (n, k, k); the
@@ -379,6 +361,20 @@ def add_pair_partials(f_u, f_uu, pair_first, pair_second, index):
         f_u[i + 1, index] += pair_first[i, 1]
         f_uu[i, index, index] += pair_second[i, 0, 0]
         f_uu[i + 1, index, index] += pair_second[i, 1, 1]
+
+
+@njit(cache=True)
+def add_torsion_warping_partials(f_u, f_uu, pair_first, pair_second, end_first, end_second):
+    """Eq. V's partials per twist (torsion_warping's pairs and clamp terms) added into the
+    stencils' partials f_u (n, k) and f_uu (n, k, k) in u = (eps, kappa_n, kappa_g, tau, ...), the
+    twist at u[3]. The mixed partials of neighbouring twists (pair_second[:, 0, 1]) couple two
+    stencils: rod_curvature.add_pair_cross_terms adds them."""
+    count = f_u.shape[0]
+    add_pair_partials(f_u, f_uu, pair_first, pair_second, 3)
+    f_u[0, 3] += end_first[0]
+    f_u[count - 1, 3] += end_first[1]
+    f_uu[0, 3, 3] += end_second[0]
+    f_uu[count - 1, 3, 3] += end_second[1]
 
 
 @njit(cache=True)
